@@ -1,0 +1,71 @@
+//! Integration speed on real data: fuzzy ray integration of OctoMap's `scan.dat` and projective
+//! integration of one 640×480 7-Scenes depth frame.
+//!
+//! Needs `FUZZYVOX_DATA` (the shared data folder); without it the benchmarks say so and skip.
+//! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench integrate`.
+
+use std::path::PathBuf;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use fuzzyvox::io::read_text_cloud;
+use fuzzyvox::io::rgbd::{
+    kinect_interval_image, read_depth_png_mm, read_intrinsics_txt, read_pose_txt,
+};
+use fuzzyvox::{DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions, VoxelMap};
+use nalgebra::Point3;
+
+fn data_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("FUZZYVOX_DATA").map(PathBuf::from);
+    if dir.is_none() {
+        eprintln!("SKIPPED: FUZZYVOX_DATA is not set; these benchmarks need the shared data");
+    }
+    dir
+}
+
+fn ray_integration(c: &mut Criterion) {
+    let Some(dir) = data_dir() else { return };
+    let cloud = read_text_cloud(&dir.join("octomap-samples/scan.dat"), Point3::origin())
+        .expect("reading scan.dat");
+    let mut group = c.benchmark_group("fuzzy_ray_scan_dat");
+    group.sample_size(10);
+    for resolution in [0.1, 0.05] {
+        group.bench_function(format!("{resolution}m"), |b| {
+            b.iter(|| {
+                let mut map = FuzzyMap::new(FuzzyConfig::new(resolution).unwrap()).unwrap();
+                map.integrate_cloud(&cloud, &IntegrationOptions::default())
+                    .unwrap();
+                map
+            })
+        });
+    }
+    group.finish();
+}
+
+fn projective_integration(c: &mut Criterion) {
+    let Some(dir) = data_dir() else { return };
+    let scene = dir.join("rgbd-7scenes-redkitchen");
+    let depth = read_depth_png_mm(&scene.join("frame-000150.depth.png")).expect("depth png");
+    let k = read_intrinsics_txt(
+        &scene.join("camera-intrinsics.txt"),
+        depth.width,
+        depth.height,
+    )
+    .expect("intrinsics");
+    let pose = read_pose_txt(&scene.join("frame-000150.pose.txt")).expect("pose");
+    let frame = DepthFrame::new(k, pose, kinect_interval_image(&depth).unwrap()).unwrap();
+    let mut group = c.benchmark_group("fuzzy_frustum_640x480");
+    for resolution in [0.05, 0.02] {
+        group.bench_function(format!("{resolution}m"), |b| {
+            b.iter(|| {
+                let mut map = FuzzyMap::new(FuzzyConfig::new(resolution).unwrap()).unwrap();
+                map.integrate_depth(&frame, &IntegrationOptions::default())
+                    .unwrap();
+                map
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, ray_integration, projective_integration);
+criterion_main!(benches);

@@ -1,0 +1,59 @@
+//! Command-line parsing and dispatch. Each command lives in its own file and only calls the
+//! library.
+
+mod info;
+mod insert;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Confidence-aware 3D mapping: dual-set fuzzy voxel maps from uncertain depth.
+#[derive(Parser)]
+#[command(name = "fuzzyvox", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    Insert(insert::InsertArgs),
+    Info(info::InfoArgs),
+}
+
+/// Parses the arguments, runs the command and reports errors with their causes.
+pub fn run() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Insert(args) => insert::run(args),
+        Command::Info(args) => info::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Parses `X,Y,Z` into a point.
+fn parse_point(text: &str) -> Result<nalgebra::Point3<f64>, String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{text}`: {e}"))?;
+    match values.as_slice() {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok(nalgebra::Point3::new(*x, *y, *z)),
+        [_, _, _] => Err(format!("`{text}`: coordinates must be finite")),
+        _ => Err(format!("`{text}`: expected X,Y,Z")),
+    }
+}
+
+/// Prints a value as one line of JSON.
+fn print_json(value: &serde_json::Value) -> anyhow::Result<()> {
+    println!("{}", serde_json::to_string(value)?);
+    Ok(())
+}

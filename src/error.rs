@@ -1,0 +1,168 @@
+//! The library's error type: every fallible public function returns [`Result`].
+
+use std::path::PathBuf;
+
+use crate::ops::OperatorError;
+
+/// What went wrong, typed so that callers can react to each case.
+///
+/// A failed call never leaves a map half-updated: every integration validates its whole input
+/// before it changes anything.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A value that must be finite was NaN or infinite.
+    #[error("{what} must be finite, got {value}")]
+    NonFinite {
+        /// Which value.
+        what: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A numeric parameter is outside its valid range.
+    #[error("{name} = {value} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// The valid range, in words.
+        expected: &'static str,
+    },
+    /// A point lies outside the range that `i32` voxel keys can address at this resolution.
+    #[error(
+        "point ({x}, {y}, {z}) is outside the addressable key range at resolution {resolution} m"
+    )]
+    OutOfKeyRange {
+        /// x coordinate (m).
+        x: f64,
+        /// y coordinate (m).
+        y: f64,
+        /// z coordinate (m).
+        z: f64,
+        /// Map resolution (m).
+        resolution: f64,
+    },
+    /// A pose is not a proper rigid transform (non-finite, or a rotation that is not orthonormal).
+    #[error("invalid pose: {0}")]
+    InvalidPose(String),
+    /// Two inputs that must agree in size do not.
+    #[error("size mismatch in {what}: expected {expected}, found {found}")]
+    SizeMismatch {
+        /// Which input.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Actual length.
+        found: usize,
+    },
+    /// An input that must hold data is empty.
+    #[error("{0} is empty")]
+    Empty(&'static str),
+    /// A confidence value lies outside `[0, 1]`.
+    #[error("confidence at index {index} is {value}, outside [0, 1]")]
+    InvalidConfidence {
+        /// Index of the point or pixel.
+        index: usize,
+        /// The offending value.
+        value: f32,
+    },
+    /// A depth interval is out of order (`P- <= P0 <= P+` must hold).
+    #[error("depth interval at pixel ({x}, {y}) is out of order: {near} <= {depth} <= {far} fails")]
+    IntervalOrder {
+        /// Pixel column.
+        x: u32,
+        /// Pixel row.
+        y: u32,
+        /// `P-` (m).
+        near: f32,
+        /// `P0` (m).
+        depth: f32,
+        /// `P+` (m).
+        far: f32,
+    },
+    /// An aggregation operator's parameters are invalid or its name unknown.
+    #[error(transparent)]
+    Operator(#[from] OperatorError),
+    /// Two maps cannot be combined.
+    #[error("maps are incompatible: {0}")]
+    Incompatible(String),
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file is damaged, truncated or of another format.
+    #[error("{}: {reason}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: FormatError,
+    },
+    /// A text input could not be parsed.
+    #[error("{}:{line}: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Why a map file could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FormatError {
+    /// The file does not start with fuzzyvox's magic bytes.
+    #[error("not a fuzzyvox map file (bad magic bytes)")]
+    BadMagic,
+    /// The file was written by a newer, unknown format version.
+    #[error("unsupported format version {0}")]
+    UnsupportedVersion(u16),
+    /// The file holds another kind of map than the one requested.
+    #[error("the file holds a {found} map, not a {expected} map")]
+    WrongKind {
+        /// The kind the caller asked for.
+        expected: &'static str,
+        /// The kind the file declares.
+        found: String,
+    },
+    /// The file is shorter or longer than its header declares.
+    #[error("length mismatch: header declares {declared} bytes of body, file has {actual}")]
+    Length {
+        /// Declared body length.
+        declared: u64,
+        /// Actual body length.
+        actual: u64,
+    },
+    /// The checksum does not match the contents.
+    #[error(
+        "checksum mismatch (stored {stored:#010x}, computed {computed:#010x}): the file is damaged"
+    )]
+    Checksum {
+        /// CRC stored in the file.
+        stored: u32,
+        /// CRC of the bytes read.
+        computed: u32,
+    },
+    /// The body could not be decoded or holds invalid values.
+    #[error("invalid contents: {0}")]
+    Invalid(String),
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Returns `value` when it is finite, else a [`Error::NonFinite`] naming `what`.
+pub(crate) fn finite(what: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::NonFinite { what, value })
+    }
+}

@@ -1,0 +1,100 @@
+use nalgebra::Point3;
+
+use crate::error::{Error, Result};
+
+/// An unordered set of 3D points in the world frame, measured from one sensor origin, with an
+/// optional confidence in `[0, 1]` per point.
+///
+/// Points that are NaN or infinite are kept here and skipped (and counted) at integration, as
+/// sensors report missing returns that way; the origin and the confidences are validated now.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointCloud {
+    origin: Point3<f64>,
+    points: Vec<Point3<f64>>,
+    confidence: Option<Vec<f32>>,
+}
+
+impl PointCloud {
+    /// A cloud of `points` seen from `origin`; the origin must be finite.
+    pub fn new(origin: Point3<f64>, points: Vec<Point3<f64>>) -> Result<Self> {
+        if let Some(value) = origin.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "sensor origin",
+                value: *value,
+            });
+        }
+        Ok(Self {
+            origin,
+            points,
+            confidence: None,
+        })
+    }
+
+    /// Attaches one confidence in `[0, 1]` per point.
+    pub fn with_confidence(mut self, confidence: Vec<f32>) -> Result<Self> {
+        if confidence.len() != self.points.len() {
+            return Err(Error::SizeMismatch {
+                what: "confidence per point",
+                expected: self.points.len(),
+                found: confidence.len(),
+            });
+        }
+        if let Some((index, &value)) = confidence
+            .iter()
+            .enumerate()
+            .find(|(_, c)| !(0.0..=1.0).contains(*c))
+        {
+            return Err(Error::InvalidConfidence { index, value });
+        }
+        self.confidence = Some(confidence);
+        Ok(self)
+    }
+
+    /// The sensor origin.
+    pub fn origin(&self) -> Point3<f64> {
+        self.origin
+    }
+
+    /// The points.
+    pub fn points(&self) -> &[Point3<f64>] {
+        &self.points
+    }
+
+    /// The per-point confidences, when given.
+    pub fn confidence(&self) -> Option<&[f32]> {
+        self.confidence.as_deref()
+    }
+
+    /// Confidence of point `i` (1 when none was given).
+    #[inline]
+    pub fn confidence_of(&self, i: usize) -> f32 {
+        self.confidence.as_ref().map_or(1.0, |c| c[i])
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether the cloud has no points.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validates_origin_and_confidence() {
+        let p = vec![Point3::new(1.0, 0.0, 0.0); 2];
+        assert!(PointCloud::new(Point3::new(f64::NAN, 0.0, 0.0), p.clone()).is_err());
+        let cloud = PointCloud::new(Point3::origin(), p).unwrap();
+        assert!(cloud.clone().with_confidence(vec![0.5]).is_err());
+        assert!(cloud.clone().with_confidence(vec![0.5, 1.5]).is_err());
+        assert!(cloud.clone().with_confidence(vec![0.5, f32::NAN]).is_err());
+        let ok = cloud.with_confidence(vec![0.5, 1.0]).unwrap();
+        assert_eq!(ok.confidence_of(0), 0.5);
+    }
+}

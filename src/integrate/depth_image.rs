@@ -1,0 +1,256 @@
+use nalgebra::Isometry3;
+
+use crate::error::{Error, Result};
+use crate::geometry::{PinholeIntrinsics, validate_pose};
+
+/// A depth image with an interval and a confidence per pixel: `P-` (near), `P0` (depth), `P+`
+/// (far), all depths along the optical axis in metres, and a confidence in `[0, 1]`.
+///
+/// A pixel is *valid* when its three depths are finite and positive and its confidence is a
+/// number greater than zero; invalid pixels (NaN, infinite, zero or negative depth, missing
+/// interval, NaN confidence) contribute nothing when integrated. Out-of-order intervals and
+/// confidences outside `[0, 1]` are errors at construction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntervalDepthImage {
+    width: u32,
+    height: u32,
+    near: Vec<f32>,
+    depth: Vec<f32>,
+    far: Vec<f32>,
+    confidence: Vec<f32>,
+}
+
+/// One valid pixel's interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PixelInterval {
+    pub near: f32,
+    pub depth: f32,
+    pub far: f32,
+    pub confidence: f32,
+}
+
+impl IntervalDepthImage {
+    /// Builds an image from row-major planes of `width × height` values each.
+    pub fn new(
+        width: u32,
+        height: u32,
+        near: Vec<f32>,
+        depth: Vec<f32>,
+        far: Vec<f32>,
+        confidence: Vec<f32>,
+    ) -> Result<Self> {
+        let pixels = (width as usize) * (height as usize);
+        if pixels == 0 {
+            return Err(Error::Empty("depth image"));
+        }
+        for (what, plane) in [
+            ("near depth plane (P-)", &near),
+            ("depth plane (P0)", &depth),
+            ("far depth plane (P+)", &far),
+            ("confidence plane", &confidence),
+        ] {
+            if plane.len() != pixels {
+                return Err(Error::SizeMismatch {
+                    what,
+                    expected: pixels,
+                    found: plane.len(),
+                });
+            }
+        }
+        let image = Self {
+            width,
+            height,
+            near,
+            depth,
+            far,
+            confidence,
+        };
+        for i in 0..pixels {
+            let c = image.confidence[i];
+            if !c.is_nan() && !(0.0..=1.0).contains(&c) {
+                return Err(Error::InvalidConfidence { index: i, value: c });
+            }
+            let (n, d, f) = (image.near[i], image.depth[i], image.far[i]);
+            if depth_valid(n) && depth_valid(d) && depth_valid(f) && !(n <= d && d <= f) {
+                return Err(Error::IntervalOrder {
+                    x: (i % width as usize) as u32,
+                    y: (i / width as usize) as u32,
+                    near: n,
+                    depth: d,
+                    far: f,
+                });
+            }
+        }
+        Ok(image)
+    }
+
+    /// Builds an image from a plain depth image and a sensor model that gives, for a depth `z`,
+    /// the interval `(P-, P+)` and a confidence. Pixels with invalid depth stay invalid.
+    ///
+    /// ```
+    /// use fuzzyvox::IntervalDepthImage;
+    /// // Kinect-like noise: σ grows with z²; the interval is ±2σ.
+    /// let depth = vec![1.0_f32, 2.0, 0.0, f32::NAN];
+    /// let image = IntervalDepthImage::from_depth(2, 2, &depth, |z| {
+    ///     let sigma = 0.0012 + 0.0019 * (z - 0.4).powi(2);
+    ///     (z - 2.0 * sigma, z + 2.0 * sigma, 1.0)
+    /// })
+    /// .unwrap();
+    /// assert_eq!(image.valid_pixels(), 2);
+    /// ```
+    pub fn from_depth(
+        width: u32,
+        height: u32,
+        depth: &[f32],
+        model: impl Fn(f32) -> (f32, f32, f32),
+    ) -> Result<Self> {
+        let mut near = vec![f32::NAN; depth.len()];
+        let mut far = vec![f32::NAN; depth.len()];
+        let mut confidence = vec![f32::NAN; depth.len()];
+        for (i, &z) in depth.iter().enumerate() {
+            if depth_valid(z) {
+                let (n, f, c) = model(z);
+                near[i] = n;
+                far[i] = f;
+                confidence[i] = c;
+            }
+        }
+        Self::new(width, height, near, depth.to_vec(), far, confidence)
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The `P-` plane, row-major.
+    pub fn near(&self) -> &[f32] {
+        &self.near
+    }
+
+    /// The `P0` plane, row-major.
+    pub fn depth(&self) -> &[f32] {
+        &self.depth
+    }
+
+    /// The `P+` plane, row-major.
+    pub fn far(&self) -> &[f32] {
+        &self.far
+    }
+
+    /// The confidence plane, row-major.
+    pub fn confidence(&self) -> &[f32] {
+        &self.confidence
+    }
+
+    /// Number of valid pixels.
+    pub fn valid_pixels(&self) -> usize {
+        (0..self.depth.len())
+            .filter(|&i| self.pixel(i).is_some())
+            .count()
+    }
+
+    /// The interval of pixel `index` (row-major), when valid.
+    #[inline]
+    pub(crate) fn pixel(&self, index: usize) -> Option<PixelInterval> {
+        let p = PixelInterval {
+            near: self.near[index],
+            depth: self.depth[index],
+            far: self.far[index],
+            confidence: self.confidence[index],
+        };
+        (depth_valid(p.near) && depth_valid(p.depth) && depth_valid(p.far) && p.confidence > 0.0)
+            .then_some(p)
+    }
+}
+
+#[inline]
+fn depth_valid(z: f32) -> bool {
+    z.is_finite() && z > 0.0
+}
+
+/// An interval depth image with the camera that took it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthFrame {
+    intrinsics: PinholeIntrinsics,
+    world_from_camera: Isometry3<f64>,
+    image: IntervalDepthImage,
+}
+
+impl DepthFrame {
+    /// Ties an image to its camera: the image size must equal the intrinsics' size and the pose
+    /// must be valid.
+    pub fn new(
+        intrinsics: PinholeIntrinsics,
+        world_from_camera: Isometry3<f64>,
+        image: IntervalDepthImage,
+    ) -> Result<Self> {
+        validate_pose(&world_from_camera)?;
+        if image.width() != intrinsics.width() || image.height() != intrinsics.height() {
+            return Err(Error::SizeMismatch {
+                what: "depth image pixels (intrinsics width × height)",
+                expected: intrinsics.width() as usize * intrinsics.height() as usize,
+                found: image.width() as usize * image.height() as usize,
+            });
+        }
+        Ok(Self {
+            intrinsics,
+            world_from_camera,
+            image,
+        })
+    }
+
+    /// The camera intrinsics.
+    pub fn intrinsics(&self) -> &PinholeIntrinsics {
+        &self.intrinsics
+    }
+
+    /// The camera pose.
+    pub fn world_from_camera(&self) -> &Isometry3<f64> {
+        &self.world_from_camera
+    }
+
+    /// The interval depth image.
+    pub fn image(&self) -> &IntervalDepthImage {
+        &self.image
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validates_sizes_order_and_confidence() {
+        let ok = |n: f32, d: f32, f: f32, c: f32| {
+            IntervalDepthImage::new(1, 1, vec![n], vec![d], vec![f], vec![c])
+        };
+        assert!(ok(1.0, 2.0, 3.0, 0.5).is_ok());
+        assert!(matches!(
+            ok(2.5, 2.0, 3.0, 0.5),
+            Err(Error::IntervalOrder { .. })
+        ));
+        assert!(matches!(
+            ok(1.0, 2.0, 3.0, 1.5),
+            Err(Error::InvalidConfidence { .. })
+        ));
+        // NaN depth or confidence: an invalid pixel, not an error.
+        assert_eq!(ok(f32::NAN, 2.0, 3.0, 0.5).unwrap().valid_pixels(), 0);
+        assert_eq!(ok(1.0, 2.0, 3.0, f32::NAN).unwrap().valid_pixels(), 0);
+        assert_eq!(ok(-1.0, 2.0, 3.0, 0.5).unwrap().valid_pixels(), 0);
+        assert!(IntervalDepthImage::new(2, 1, vec![1.0], vec![1.0], vec![1.0], vec![1.0]).is_err());
+        assert!(IntervalDepthImage::new(0, 0, vec![], vec![], vec![], vec![]).is_err());
+    }
+
+    #[test]
+    fn frame_size_must_match_intrinsics() {
+        let k = PinholeIntrinsics::new(2, 2, 1.0, 1.0, 1.0, 1.0).unwrap();
+        let image = IntervalDepthImage::from_depth(1, 1, &[1.0], |z| (z, z, 1.0)).unwrap();
+        assert!(DepthFrame::new(k, Isometry3::identity(), image).is_err());
+    }
+}

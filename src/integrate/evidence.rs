@@ -1,0 +1,154 @@
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result, finite};
+use crate::ops::TConorm;
+use crate::storage::{AccessorMut, BlockGrid, VoxelKey};
+
+/// The evidence one scan gives one voxel: how strongly it says occupied and how strongly free,
+/// each in `[0, 1]`, already weighted by confidence.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Evidence {
+    /// Occupied evidence `o`.
+    pub occupied: f32,
+    /// Free evidence `e`.
+    pub free: f32,
+}
+
+/// One scan's evidence: per voxel, the strongest occupied and the strongest free evidence that
+/// any ray or pixel of the scan gave it.
+pub type ScanEvidence = BlockGrid<Evidence>;
+
+/// Raises the evidence at `key` to at least `occupied` / `free`.
+#[inline]
+pub(crate) fn raise(acc: &mut AccessorMut<'_, Evidence>, key: VoxelKey, occupied: f32, free: f32) {
+    let cell = acc.get_or_insert(key);
+    cell.occupied = cell.occupied.max(occupied);
+    cell.free = cell.free.max(free);
+}
+
+/// Combines two partial scans by taking the larger evidence per voxel (exact in floating point,
+/// so the result does not depend on how work was split).
+pub(crate) fn merge_max(mut a: ScanEvidence, b: ScanEvidence) -> ScanEvidence {
+    if a.block_count() < b.block_count() {
+        return merge_max(b, a);
+    }
+    for (key, block) in b.blocks() {
+        let position = a.ensure_block(key);
+        let target = a.block_at_mut(position);
+        for (t, s) in target.cells.iter_mut().zip(block.cells.iter()) {
+            t.occupied = t.occupied.max(s.occupied);
+            t.free = t.free.max(s.free);
+        }
+    }
+    a
+}
+
+/// How measurements become evidence.
+///
+/// A measurement of confidence `c` gives free evidence `g⁻¹(c · g(free_gain))` to the voxels it
+/// sees through and occupied evidence `g⁻¹(c · g(occupied_gain · φ))` around its end point, where
+/// `g` is the additive generator of the map's t-conorm (so `c = 0.5` counts as half an
+/// observation) and `φ` in `[0, 1]` is the spatial kernel. For the non-Archimedean maximum the
+/// weighting is `c · μ`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvidenceModel {
+    /// Occupied evidence of one certain hit at the kernel's peak (`k_O`, default 0.7).
+    pub occupied_gain: f32,
+    /// Free evidence of one certain pass-through (`k_E`, default 0.6).
+    pub free_gain: f32,
+    /// Angular footprint of a beam in radians: the occupied kernel around a point at range `r`
+    /// has lateral σ = `r × angular_resolution` and reaches out to 2σ (at most
+    /// [`EvidenceModel::MAX_KERNEL_VOXELS`] voxels). 0 puts all occupied evidence in the end
+    /// voxel. Default 0.002 rad (0.11°).
+    pub angular_resolution: f64,
+}
+
+impl EvidenceModel {
+    /// Largest kernel radius, in voxels, around a point's end voxel.
+    pub const MAX_KERNEL_VOXELS: i32 = 4;
+
+    /// Checks that the gains lie in `(0, 1]` and the angular resolution in `[0, 0.1]` rad.
+    pub fn validate(self) -> Result<Self> {
+        for (name, value) in [
+            ("occupied_gain", self.occupied_gain),
+            ("free_gain", self.free_gain),
+        ] {
+            if !(value > 0.0 && value <= 1.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: f64::from(value),
+                    expected: "an evidence gain in (0, 1]",
+                });
+            }
+        }
+        finite("angular_resolution", self.angular_resolution)?;
+        if !(0.0..=0.1).contains(&self.angular_resolution) {
+            return Err(Error::InvalidParameter {
+                name: "angular_resolution",
+                value: self.angular_resolution,
+                expected: "a beam footprint between 0 and 0.1 rad",
+            });
+        }
+        Ok(self)
+    }
+
+    /// Free evidence of a measurement with confidence `c`.
+    #[inline]
+    pub fn free(&self, operator: &TConorm, c: f32) -> f32 {
+        operator.weighted(self.free_gain, c)
+    }
+
+    /// Occupied evidence of a measurement with confidence `c` where the kernel is `phi`.
+    #[inline]
+    pub fn occupied(&self, operator: &TConorm, c: f32, phi: f32) -> f32 {
+        operator.weighted(self.occupied_gain * phi, c)
+    }
+}
+
+impl Default for EvidenceModel {
+    fn default() -> Self {
+        Self {
+            occupied_gain: 0.7,
+            free_gain: 0.6,
+            angular_resolution: 0.002,
+        }
+    }
+}
+
+/// Per-call options of an integration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct IntegrationOptions {
+    /// Rays longer than this (metres; for depth images, depth along the optical axis) are cut
+    /// here and only clear free space. `None`: no limit.
+    pub max_range: Option<f64>,
+}
+
+impl IntegrationOptions {
+    /// Checks that `max_range`, when set, is finite and positive.
+    pub fn validate(self) -> Result<Self> {
+        if let Some(range) = self.max_range {
+            finite("max_range", range)?;
+            if range <= 0.0 {
+                return Err(Error::InvalidParameter {
+                    name: "max_range",
+                    value: range,
+                    expected: "a positive range in metres",
+                });
+            }
+        }
+        Ok(self)
+    }
+}
+
+/// What an integration did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct IntegrationStats {
+    /// Points (or valid pixels) that contributed.
+    pub integrated: usize,
+    /// Points skipped because they were not finite (or pixels that were invalid).
+    pub skipped: usize,
+    /// Rays cut at `max_range`.
+    pub clipped: usize,
+    /// Voxels whose cells received evidence.
+    pub voxels_updated: usize,
+}

@@ -1,0 +1,357 @@
+use nalgebra::{Matrix3, Point3, Vector3};
+use rayon::prelude::*;
+
+use super::depth_image::{DepthFrame, PixelInterval};
+use super::evidence::{
+    Evidence, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence,
+};
+use crate::error::{Error, Result};
+use crate::ops::TConorm;
+use crate::storage::{BLOCK_CELLS, BLOCK_SIDE, Block, BlockKey, KeyBox, Resolution};
+
+/// Largest frustum bounding box, in blocks, that one depth image may span (a guard against
+/// absurd depths; ordinary frames span thousands).
+const MAX_FRUSTUM_BLOCKS: u128 = 1 << 26;
+
+/// Side of the square pixel tiles whose largest far depth culls blocks.
+const TILE: u32 = 8;
+
+/// Turns an interval depth image into one scan's evidence by projective frustum integration.
+///
+/// Every block that the camera frustum touches in front of the observed surfaces is visited;
+/// each of its voxel centres is projected into the image and compared, by its depth `z` along
+/// the optical axis, with that pixel's interval `(P-, P0, P+)` and confidence `c`; with `δ` half
+/// a voxel diagonal:
+/// - `z < P- - δ`: free evidence (the voxel lies in front of the surface);
+/// - `P- - δ <= z <= P+ + δ`: occupied evidence `k_O · φ(z)`, weighted by `c`;
+/// - `z > P+ + δ`: nothing (occluded).
+///
+/// `φ` is a tent that is flat within `δ` of `P0` and falls linearly to zero at `P- - δ` and
+/// `P+ + δ`; its height `2δ / (P+ - P- + 2δ)` keeps the evidence summed along the ray that of
+/// one sharp hit, so wide (far, uncertain) intervals commit less per voxel. A pixel whose depth
+/// exceeds `max_range` clears free space up to `max_range` and marks nothing occupied. Invalid
+/// pixels contribute nothing.
+///
+/// Blocks are found by culling the blocks of the frustum's bounding box against the largest far
+/// depth over 8×8 pixel tiles (conservative, so no observed block is missed) and are processed in
+/// parallel, each by one thread: the result is the same for any number of threads.
+pub fn depth_evidence(
+    frame: &DepthFrame,
+    resolution: &Resolution,
+    model: &EvidenceModel,
+    operator: &TConorm,
+    options: &IntegrationOptions,
+) -> Result<(ScanEvidence, IntegrationStats)> {
+    let options = options.validate()?;
+    let max_range = options.max_range.unwrap_or(f64::INFINITY) as f32;
+    let image = frame.image();
+    let (width, height) = (image.width(), image.height());
+    let half_diagonal = (0.5 * 3f64.sqrt() * resolution.size()) as f32;
+
+    // Per pixel: its interval and the evidence that does not depend on the voxel.
+    let pixels: Vec<Option<PixelEvidence>> = (0..image.depth().len())
+        .into_par_iter()
+        .map(|i| {
+            image
+                .pixel(i)
+                .map(|p| PixelEvidence::new(p, model, operator, max_range, half_diagonal))
+        })
+        .collect();
+    let integrated = pixels.iter().flatten().count();
+    let stats = IntegrationStats {
+        integrated,
+        skipped: pixels.len() - integrated,
+        clipped: pixels.iter().flatten().filter(|p| p.beyond_range).count(),
+        voxels_updated: 0,
+    };
+    if integrated == 0 {
+        return Ok((ScanEvidence::new(), stats));
+    }
+
+    let tiles = TileReach::new(&pixels, width, height);
+    let camera = CameraView::new(frame, resolution);
+    let frustum = frustum_box(frame, resolution, tiles.max_reach)?;
+    if frustum.block_count() > MAX_FRUSTUM_BLOCKS {
+        return Err(Error::InvalidParameter {
+            name: "depth image reach",
+            value: f64::from(tiles.max_reach),
+            expected: "a frustum of at most 2^26 blocks at this resolution; set max_range",
+        });
+    }
+    let candidates: Vec<BlockKey> = frustum
+        .blocks()
+        .filter(|&key| camera.block_may_be_observed(key, &tiles))
+        .collect();
+
+    let blocks: Vec<(BlockKey, Box<Block<Evidence>>)> = candidates
+        .par_iter()
+        .filter_map(|&key| {
+            camera
+                .block_evidence(key, &pixels, model, operator, half_diagonal)
+                .map(|b| (key, b))
+        })
+        .collect();
+    let mut evidence = ScanEvidence::new();
+    for (key, block) in blocks {
+        evidence.insert_block(key, block);
+    }
+    Ok((evidence, stats))
+}
+
+/// What one valid pixel contributes.
+#[derive(Clone, Copy)]
+struct PixelEvidence {
+    interval: PixelInterval,
+    /// Free evidence for voxels in front of the interval.
+    free: f32,
+    /// Voxels with `z` below this get free evidence.
+    free_until: f32,
+    /// Voxels with `z` up to this can get any evidence.
+    reach: f32,
+    beyond_range: bool,
+}
+
+impl PixelEvidence {
+    fn new(
+        interval: PixelInterval,
+        model: &EvidenceModel,
+        operator: &TConorm,
+        max_range: f32,
+        delta: f32,
+    ) -> Self {
+        let beyond_range = interval.depth > max_range;
+        let free_until = if beyond_range {
+            max_range
+        } else {
+            interval.near - delta
+        };
+        let reach = if beyond_range {
+            max_range
+        } else {
+            interval.far + delta
+        };
+        Self {
+            interval,
+            free: model.free(operator, interval.confidence),
+            free_until,
+            reach,
+            beyond_range,
+        }
+    }
+
+    /// Evidence for a voxel whose centre lies at depth `z` on this pixel.
+    #[inline]
+    fn at(
+        &self,
+        z: f32,
+        model: &EvidenceModel,
+        operator: &TConorm,
+        delta: f32,
+    ) -> Option<Evidence> {
+        if z < self.free_until {
+            return Some(Evidence {
+                occupied: 0.0,
+                free: self.free,
+            });
+        }
+        if self.beyond_range || z > self.reach {
+            return None;
+        }
+        let p = &self.interval;
+        let height = 2.0 * delta / (p.far - p.near + 2.0 * delta);
+        let (low, high) = (p.near - delta, p.far + delta);
+        let shape = if (z - p.depth).abs() <= delta {
+            1.0
+        } else if z < p.depth {
+            (z - low) / (p.depth - delta - low)
+        } else {
+            (high - z) / (high - (p.depth + delta))
+        };
+        let phi = (height * shape).clamp(0.0, 1.0);
+        (phi > 0.0).then(|| Evidence {
+            occupied: model.occupied(operator, p.confidence, phi),
+            free: 0.0,
+        })
+    }
+}
+
+/// The largest reach (far depth + δ, or max range) over square pixel tiles.
+struct TileReach {
+    columns: u32,
+    rows: u32,
+    reach: Vec<f32>,
+    max_reach: f32,
+}
+
+impl TileReach {
+    fn new(pixels: &[Option<PixelEvidence>], width: u32, height: u32) -> Self {
+        let columns = width.div_ceil(TILE);
+        let rows = height.div_ceil(TILE);
+        let mut reach = vec![f32::NEG_INFINITY; (columns * rows) as usize];
+        for (i, p) in pixels.iter().enumerate() {
+            if let Some(p) = p {
+                let (x, y) = (i as u32 % width, i as u32 / width);
+                let t = ((y / TILE) * columns + x / TILE) as usize;
+                reach[t] = reach[t].max(p.reach);
+            }
+        }
+        let max_reach = reach.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        Self {
+            columns,
+            rows,
+            reach,
+            max_reach,
+        }
+    }
+
+    /// Largest reach over the pixel rectangle `[u0, u1] × [v0, v1]` (inclusive).
+    fn max_over(&self, u0: u32, u1: u32, v0: u32, v1: u32) -> f32 {
+        let mut best = f32::NEG_INFINITY;
+        for ty in (v0 / TILE)..=(v1 / TILE).min(self.rows - 1) {
+            for tx in (u0 / TILE)..=(u1 / TILE).min(self.columns - 1) {
+                best = best.max(self.reach[(ty * self.columns + tx) as usize]);
+            }
+        }
+        best
+    }
+}
+
+/// The camera as seen from the voxel grid: everything needed to project voxel centres.
+struct CameraView {
+    camera_from_world: Matrix3<f64>,
+    camera_in_world: Vector3<f64>,
+    fx: f64,
+    fy: f64,
+    cx: f64,
+    cy: f64,
+    width: u32,
+    height: u32,
+    resolution: Resolution,
+}
+
+impl CameraView {
+    fn new(frame: &DepthFrame, resolution: &Resolution) -> Self {
+        let pose = frame.world_from_camera();
+        let k = frame.intrinsics();
+        Self {
+            camera_from_world: pose.rotation.to_rotation_matrix().matrix().transpose(),
+            camera_in_world: pose.translation.vector,
+            fx: k.fx(),
+            fy: k.fy(),
+            cx: k.cx(),
+            cy: k.cy(),
+            width: k.width(),
+            height: k.height(),
+            resolution: *resolution,
+        }
+    }
+
+    fn to_camera(&self, p: &Point3<f64>) -> Vector3<f64> {
+        self.camera_from_world * (p.coords - self.camera_in_world)
+    }
+
+    /// Whether any voxel of the block could lie in front of some pixel's reach (conservative).
+    fn block_may_be_observed(&self, key: BlockKey, tiles: &TileReach) -> bool {
+        let side = BLOCK_SIDE as f64 * self.resolution.size();
+        let corner = self.resolution.corner(key.origin());
+        let center = self.to_camera(&(corner + Vector3::repeat(0.5 * side)));
+        let radius = 0.5 * 3f64.sqrt() * side;
+        if center.z + radius <= 0.0 {
+            return false;
+        }
+        let near = center.z - radius;
+        if near >= f64::from(tiles.max_reach) {
+            return false;
+        }
+        let (w, h) = (f64::from(self.width), f64::from(self.height));
+        let (u0, u1, v0, v1) = if near <= 1e-6 {
+            // The block straddles the camera plane: it may project anywhere.
+            (0.0, w - 1.0, 0.0, h - 1.0)
+        } else {
+            let far = center.z + radius;
+            let xs = [
+                (center.x - radius) / near,
+                (center.x - radius) / far,
+                (center.x + radius) / near,
+                (center.x + radius) / far,
+            ];
+            let ys = [
+                (center.y - radius) / near,
+                (center.y - radius) / far,
+                (center.y + radius) / near,
+                (center.y + radius) / far,
+            ];
+            let min = |v: [f64; 4]| v.into_iter().fold(f64::INFINITY, f64::min);
+            let max = |v: [f64; 4]| v.into_iter().fold(f64::NEG_INFINITY, f64::max);
+            (
+                (self.fx * min(xs) + self.cx - 0.5).floor().max(0.0),
+                (self.fx * max(xs) + self.cx + 0.5).ceil().min(w - 1.0),
+                (self.fy * min(ys) + self.cy - 0.5).floor().max(0.0),
+                (self.fy * max(ys) + self.cy + 0.5).ceil().min(h - 1.0),
+            )
+        };
+        if u0 > u1 || v0 > v1 {
+            return false;
+        }
+        let reach = tiles.max_over(u0 as u32, u1 as u32, v0 as u32, v1 as u32);
+        near < f64::from(reach)
+    }
+
+    /// Evidence for one block's voxels, or `None` when no voxel received any.
+    fn block_evidence(
+        &self,
+        key: BlockKey,
+        pixels: &[Option<PixelEvidence>],
+        model: &EvidenceModel,
+        operator: &TConorm,
+        delta: f32,
+    ) -> Option<Box<Block<Evidence>>> {
+        let size = self.resolution.size();
+        let first = self.to_camera(&self.resolution.center(key.origin()));
+        let step_x = self.camera_from_world.column(0) * size;
+        let step_y = self.camera_from_world.column(1) * size;
+        let step_z = self.camera_from_world.column(2) * size;
+        let mut block: Option<Box<Block<Evidence>>> = None;
+        for cell in 0..BLOCK_CELLS {
+            let (i, j, l) = (cell % 8, (cell / 8) % 8, cell / 64);
+            let p = first + step_x * i as f64 + step_y * j as f64 + step_z * l as f64;
+            if p.z <= 0.0 {
+                continue;
+            }
+            let u = (self.fx * p.x / p.z + self.cx + 0.5).floor();
+            let v = (self.fy * p.y / p.z + self.cy + 0.5).floor();
+            if !(u >= 0.0 && v >= 0.0 && u < f64::from(self.width) && v < f64::from(self.height)) {
+                continue;
+            }
+            let index = v as usize * self.width as usize + u as usize;
+            let Some(pixel) = &pixels[index] else {
+                continue;
+            };
+            if let Some(e) = pixel.at(p.z as f32, model, operator, delta) {
+                block.get_or_insert_with(Box::default).cells[cell] = e;
+            }
+        }
+        block
+    }
+}
+
+/// The voxel box around the camera centre and the image corners pushed out to `reach`.
+fn frustum_box(frame: &DepthFrame, resolution: &Resolution, reach: f32) -> Result<KeyBox> {
+    let k = frame.intrinsics();
+    let pose = frame.world_from_camera();
+    let z = f64::from(reach);
+    let (w, h) = (f64::from(k.width()), f64::from(k.height()));
+    let mut lo = pose.translation.vector;
+    let mut hi = lo;
+    for (u, v) in [
+        (-0.5, -0.5),
+        (w - 0.5, -0.5),
+        (-0.5, h - 0.5),
+        (w - 0.5, h - 0.5),
+    ] {
+        let corner = pose * k.back_project(u, v, z);
+        lo = lo.inf(&corner.coords);
+        hi = hi.sup(&corner.coords);
+    }
+    KeyBox::from_points(resolution, &Point3::from(lo), &Point3::from(hi))
+}

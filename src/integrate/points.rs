@@ -1,0 +1,168 @@
+use nalgebra::Point3;
+use rayon::prelude::*;
+
+use super::cloud::PointCloud;
+use super::evidence::{
+    EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence, merge_max, raise,
+};
+use super::raywalk::walk_ray;
+use crate::error::{Error, Result};
+use crate::ops::TConorm;
+use crate::storage::{AccessorMut, Resolution, VoxelKey};
+
+/// Points per unit of parallel work.
+const CHUNK: usize = 1024;
+
+/// Turns a point cloud into one scan's evidence.
+///
+/// Each ray gives free evidence to every voxel it passes through before its end voxel (except
+/// voxels inside its own occupied kernel) and occupied evidence to the end voxel and, with a
+/// range-dependent Gaussian kernel, to its neighbours. Rays longer than `max_range` are cut
+/// there and give free evidence only. Non-finite points are skipped and counted.
+///
+/// Errors (before any work): a finite point or cut end point outside the key range.
+pub fn cloud_evidence(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    model: &EvidenceModel,
+    operator: &TConorm,
+    options: &IntegrationOptions,
+) -> Result<(ScanEvidence, IntegrationStats)> {
+    let options = options.validate()?;
+    let origin = cloud.origin();
+    let origin_key = resolution.key_of(&origin)?;
+    let rays: Vec<Option<Ray>> = cloud
+        .points()
+        .par_iter()
+        .map(|p| Ray::new(&origin, p, options.max_range))
+        .collect();
+    // Validate every end key first, so that a bad point fails the call before any work.
+    if let Some(ray) = rays
+        .par_iter()
+        .flatten()
+        .find_first(|ray| resolution.try_key_of(&ray.end).is_none())
+    {
+        return Err(Error::OutOfKeyRange {
+            x: ray.end.x,
+            y: ray.end.y,
+            z: ray.end.z,
+            resolution: resolution.size(),
+        });
+    }
+    // `fold` keeps one partial scan per piece of work that rayon schedules (a few per thread);
+    // `max` combines them exactly, so the split does not change the result.
+    let evidence = rays
+        .par_chunks(CHUNK)
+        .enumerate()
+        .fold(ScanEvidence::new, |mut scan, (chunk_index, chunk)| {
+            let mut acc = AccessorMut::new(&mut scan);
+            for (offset, ray) in chunk.iter().enumerate() {
+                if let Some(ray) = ray {
+                    let c = cloud.confidence_of(chunk_index * CHUNK + offset);
+                    ray.deposit(&mut acc, resolution, origin_key, model, operator, c);
+                }
+            }
+            scan
+        })
+        .reduce(ScanEvidence::new, merge_max);
+    let integrated = rays.iter().flatten().count();
+    let stats = IntegrationStats {
+        integrated,
+        skipped: rays.len() - integrated,
+        clipped: rays.iter().flatten().filter(|r| r.clipped).count(),
+        voxels_updated: 0,
+    };
+    Ok((evidence, stats))
+}
+
+/// One measurement ray, already cut at `max_range`.
+struct Ray {
+    origin: Point3<f64>,
+    end: Point3<f64>,
+    range: f64,
+    clipped: bool,
+}
+
+impl Ray {
+    fn new(origin: &Point3<f64>, point: &Point3<f64>, max_range: Option<f64>) -> Option<Ray> {
+        if !point.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let delta = point - origin;
+        let range = delta.norm();
+        match max_range {
+            Some(max) if range > max => Some(Ray {
+                origin: *origin,
+                end: origin + delta * (max / range),
+                range: max,
+                clipped: true,
+            }),
+            _ => Some(Ray {
+                origin: *origin,
+                end: *point,
+                range,
+                clipped: false,
+            }),
+        }
+    }
+
+    fn deposit(
+        &self,
+        acc: &mut AccessorMut<'_, super::Evidence>,
+        resolution: &Resolution,
+        origin_key: VoxelKey,
+        model: &EvidenceModel,
+        operator: &TConorm,
+        confidence: f32,
+    ) {
+        if confidence <= 0.0 {
+            return;
+        }
+        // Validated by the caller.
+        let Some(end_key) = resolution.try_key_of(&self.end) else {
+            return;
+        };
+        let free = model.free(operator, confidence);
+        let sigma = self.range * model.angular_resolution;
+        let reach = 2.0 * sigma;
+        let kernel = !self.clipped && reach > 0.5 * resolution.size();
+        walk_ray(
+            resolution,
+            &self.origin,
+            &self.end,
+            origin_key,
+            end_key,
+            |key| {
+                // Voxels inside this ray's own occupied kernel get no free evidence from it.
+                if kernel && (resolution.center(key) - self.end).norm() <= reach {
+                    return;
+                }
+                raise(acc, key, 0.0, free);
+            },
+        );
+        if self.clipped {
+            return;
+        }
+        raise(acc, end_key, model.occupied(operator, confidence, 1.0), 0.0);
+        if kernel {
+            let n =
+                ((reach / resolution.size()).ceil() as i32).min(EvidenceModel::MAX_KERNEL_VOXELS);
+            let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+            for dz in -n..=n {
+                for dy in -n..=n {
+                    for dx in -n..=n {
+                        if dx == 0 && dy == 0 && dz == 0 {
+                            continue;
+                        }
+                        let key = VoxelKey::new(end_key.x + dx, end_key.y + dy, end_key.z + dz);
+                        let d2 = (resolution.center(key) - self.end).norm_squared();
+                        if d2 <= reach * reach {
+                            let phi = (-d2 * inv_two_sigma2).exp() as f32;
+                            raise(acc, key, model.occupied(operator, confidence, phi), 0.0);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

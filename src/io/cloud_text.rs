@@ -1,0 +1,94 @@
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+use nalgebra::Point3;
+
+use crate::error::{Error, Result};
+use crate::integrate::PointCloud;
+
+/// Reads a plain text point cloud: one point per line as `x y z` or `x y z confidence`
+/// (separated by spaces, tabs or commas), metres in the world frame, confidence in `[0, 1]`.
+/// Blank lines and lines starting with `#` are ignored. Either every point has a confidence or
+/// none does.
+///
+/// Coordinates written as `nan` or `inf` are kept (integration skips them); anything else that
+/// is not a number is an error naming the line.
+pub fn read_text_cloud(path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let parse_error = |line: usize, message: String| Error::Parse {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let mut points = Vec::new();
+    let mut confidence = Vec::new();
+    let mut columns = None;
+    let mut text = String::new();
+    let mut reader = BufReader::new(file);
+    let mut line_number = 0;
+    loop {
+        text.clear();
+        let read = reader.read_line(&mut text).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        if read == 0 {
+            break;
+        }
+        line_number += 1;
+        let line = text.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let mut values = [0f64; 4];
+        let mut count = 0;
+        for field in line
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|f| !f.is_empty())
+        {
+            if count == 4 {
+                return Err(parse_error(line_number, "more than 4 values".into()));
+            }
+            values[count] = field
+                .parse()
+                .map_err(|_| parse_error(line_number, format!("`{field}` is not a number")))?;
+            count += 1;
+        }
+        if count < 3 {
+            return Err(parse_error(
+                line_number,
+                format!("expected `x y z [confidence]`, found {count} values"),
+            ));
+        }
+        match columns {
+            None => columns = Some(count),
+            Some(c) if c != count => {
+                return Err(parse_error(
+                    line_number,
+                    format!("{count} values where earlier lines had {c}"),
+                ));
+            }
+            _ => {}
+        }
+        points.push(Point3::new(values[0], values[1], values[2]));
+        if count == 4 {
+            let c = values[3] as f32;
+            if !(0.0..=1.0).contains(&c) {
+                return Err(parse_error(
+                    line_number,
+                    format!("confidence {} is outside [0, 1]", values[3]),
+                ));
+            }
+            confidence.push(c);
+        }
+    }
+    let cloud = PointCloud::new(origin, points)?;
+    if columns == Some(4) {
+        cloud.with_confidence(confidence)
+    } else {
+        Ok(cloud)
+    }
+}

@@ -1,0 +1,257 @@
+//! The container shared by every native map file: a fixed header, a postcard body, a CRC32.
+//!
+//! Layout (little endian):
+//!
+//! | bytes | field |
+//! |---|---|
+//! | 0..8 | magic `FUZZYVOX` |
+//! | 8..10 | format version (1) |
+//! | 10 | map kind (1 fuzzy, 2 log-odds, 3 alpha-cut) |
+//! | 11 | operator family code (255: none) |
+//! | 12..20 | operator parameter (f64; 0 when the family has none) |
+//! | 20..28 | resolution in metres (f64) |
+//! | 28..36 | body length in bytes (u64) |
+//! | 36..40 | CRC32 of bytes 0..36 followed by the body |
+//! | 40.. | body (postcard) |
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::error::{Error, FormatError, Result};
+use crate::ops::Family;
+
+const MAGIC: &[u8; 8] = b"FUZZYVOX";
+const VERSION: u16 = 1;
+const HEADER_LEN: usize = 40;
+const NO_OPERATOR: u8 = 255;
+
+/// Which map a file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum MapKind {
+    /// The dual-set fuzzy map.
+    Fuzzy,
+    /// The log-odds map (OctoMap semantics).
+    LogOdds,
+    /// The alpha-cut log-odds map.
+    AlphaCut,
+}
+
+impl MapKind {
+    fn code(self) -> u8 {
+        match self {
+            Self::Fuzzy => 1,
+            Self::LogOdds => 2,
+            Self::AlphaCut => 3,
+        }
+    }
+
+    fn from_code(code: u8) -> Option<Self> {
+        match code {
+            1 => Some(Self::Fuzzy),
+            2 => Some(Self::LogOdds),
+            3 => Some(Self::AlphaCut),
+            _ => None,
+        }
+    }
+
+    /// Lower-case name (`fuzzy`, `logodds`, `alpha`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fuzzy => "fuzzy",
+            Self::LogOdds => "logodds",
+            Self::AlphaCut => "alpha",
+        }
+    }
+}
+
+/// The fixed header of a map file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapHeader {
+    /// Format version.
+    pub version: u16,
+    /// Map kind.
+    pub kind: MapKind,
+    /// Aggregation operator, for maps that have one.
+    pub operator: Option<Family>,
+    /// Voxel size in metres.
+    pub resolution: f64,
+    /// Body length in bytes.
+    pub body_len: u64,
+}
+
+/// Reads and checks a map file's header and checksum without decoding the body.
+pub fn read_header(path: &Path) -> Result<MapHeader> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    split(&bytes)
+        .map(|(header, _)| header)
+        .map_err(|reason| Error::Format {
+            path: path.to_path_buf(),
+            reason,
+        })
+}
+
+/// Serialises a whole file: header and postcard body.
+pub(crate) fn encode<T: Serialize>(
+    kind: MapKind,
+    operator: Option<Family>,
+    resolution: f64,
+    body: &T,
+) -> Vec<u8> {
+    // Encoding plain data into a Vec cannot fail.
+    let body = postcard::to_stdvec(body).unwrap_or_default();
+    let (code, parameter) = operator.map_or((NO_OPERATOR, 0.0), family_code);
+    let mut bytes = Vec::with_capacity(HEADER_LEN + body.len());
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&VERSION.to_le_bytes());
+    bytes.push(kind.code());
+    bytes.push(code);
+    bytes.extend_from_slice(&parameter.to_le_bytes());
+    bytes.extend_from_slice(&resolution.to_le_bytes());
+    bytes.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&bytes);
+    crc.update(&body);
+    bytes.extend_from_slice(&crc.finalize().to_le_bytes());
+    bytes.extend_from_slice(&body);
+    bytes
+}
+
+/// Checks magic, version, declared length and checksum; returns the header and the body.
+pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
+    if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+        return Err(FormatError::BadMagic);
+    }
+    if bytes.len() < HEADER_LEN {
+        return Err(FormatError::Length {
+            declared: 0,
+            actual: 0,
+        });
+    }
+    let u64_at = |at: usize| {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&bytes[at..at + 8]);
+        u64::from_le_bytes(b)
+    };
+    let version = u16::from_le_bytes([bytes[8], bytes[9]]);
+    if version != VERSION {
+        return Err(FormatError::UnsupportedVersion(version));
+    }
+    let body_len = u64_at(28);
+    let actual = (bytes.len() - HEADER_LEN) as u64;
+    if body_len != actual {
+        return Err(FormatError::Length {
+            declared: body_len,
+            actual,
+        });
+    }
+    let body = &bytes[HEADER_LEN..];
+    let stored = u32::from_le_bytes([bytes[36], bytes[37], bytes[38], bytes[39]]);
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&bytes[..36]);
+    crc.update(body);
+    let computed = crc.finalize();
+    if stored != computed {
+        return Err(FormatError::Checksum { stored, computed });
+    }
+    let kind = MapKind::from_code(bytes[10])
+        .ok_or_else(|| FormatError::Invalid(format!("unknown map kind code {}", bytes[10])))?;
+    let parameter = f64::from_bits(u64_at(12));
+    let operator = match bytes[11] {
+        NO_OPERATOR => None,
+        code => Some(family_from_code(code, parameter)?),
+    };
+    Ok((
+        MapHeader {
+            version,
+            kind,
+            operator,
+            resolution: f64::from_bits(u64_at(20)),
+            body_len,
+        },
+        body,
+    ))
+}
+
+fn family_code(family: Family) -> (u8, f64) {
+    let code = match family {
+        Family::Minimum => 0,
+        Family::Product => 1,
+        Family::Lukasiewicz => 2,
+        Family::Drastic => 3,
+        Family::NilpotentMinimum => 4,
+        Family::Hamacher { .. } => 5,
+        Family::Einstein => 6,
+        Family::Yager { .. } => 7,
+        Family::Frank { .. } => 8,
+        Family::Dombi { .. } => 9,
+        Family::SchweizerSklar { .. } => 10,
+        Family::AczelAlsina { .. } => 11,
+    };
+    (code, family.parameter().unwrap_or(0.0))
+}
+
+fn family_from_code(code: u8, p: f64) -> Result<Family, FormatError> {
+    let family = match code {
+        0 => Family::Minimum,
+        1 => Family::Product,
+        2 => Family::Lukasiewicz,
+        3 => Family::Drastic,
+        4 => Family::NilpotentMinimum,
+        5 => Family::Hamacher { gamma: p },
+        6 => Family::Einstein,
+        7 => Family::Yager { p },
+        8 => Family::Frank { s: p },
+        9 => Family::Dombi { lambda: p },
+        10 => Family::SchweizerSklar { p },
+        11 => Family::AczelAlsina { p },
+        _ => {
+            return Err(FormatError::Invalid(format!(
+                "unknown operator code {code}"
+            )));
+        }
+    };
+    family
+        .validate()
+        .map_err(|e| FormatError::Invalid(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_family_round_trips_through_its_code() {
+        for family in Family::catalogue() {
+            let (code, p) = family_code(family);
+            assert_eq!(family_from_code(code, p).unwrap(), family);
+        }
+    }
+
+    #[test]
+    fn damage_is_detected() {
+        let bytes = encode(
+            MapKind::Fuzzy,
+            Some(Family::Product),
+            0.1,
+            &vec![1u32, 2, 3],
+        );
+        assert!(split(&bytes).is_ok());
+        assert_eq!(
+            split(b"PK\x03\x04 zip file").unwrap_err(),
+            FormatError::BadMagic
+        );
+        assert!(matches!(
+            split(&bytes[..bytes.len() - 1]),
+            Err(FormatError::Length { .. })
+        ));
+        for i in 8..bytes.len() {
+            let mut flipped = bytes.clone();
+            flipped[i] ^= 0x10;
+            assert!(split(&flipped).is_err(), "flip at byte {i} went unnoticed");
+        }
+    }
+}

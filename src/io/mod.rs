@@ -1,0 +1,11 @@
+//! Reading and writing files: native map files and text point clouds.
+
+mod atomic;
+mod cloud_text;
+mod fuzzy_file;
+mod mapfile;
+pub mod rgbd;
+
+pub use atomic::write_atomic;
+pub use cloud_text::read_text_cloud;
+pub use mapfile::{MapHeader, MapKind, read_header};

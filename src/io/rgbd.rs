@@ -1,0 +1,124 @@
+//! RGB-D frames in the 7-Scenes / 3DMatch layout: `frame-N.depth.png` (16-bit millimetres,
+//! 0 = no reading), `frame-N.pose.txt` (4×4 `world_from_camera`, row-major) and
+//! `camera-intrinsics.txt` (3×3 K).
+
+use std::path::Path;
+
+use nalgebra::{Isometry3, Matrix4};
+
+use crate::error::{Error, Result};
+use crate::geometry::{PinholeIntrinsics, pose_from_matrix};
+use crate::integrate::IntervalDepthImage;
+
+/// A depth image in metres, row-major; 0 where the sensor gave no reading.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Depth along the optical axis in metres, row-major.
+    pub depth: Vec<f32>,
+}
+
+/// Reads a 16-bit PNG of depth in millimetres.
+pub fn read_depth_png_mm(path: &Path) -> Result<DepthImage> {
+    let format = |message: String| Error::Parse {
+        path: path.to_path_buf(),
+        line: 0,
+        message,
+    };
+    let decoded = image::ImageReader::open(path)
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .with_guessed_format()
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .decode()
+        .map_err(|e| format(format!("not a readable image: {e}")))?;
+    let image::DynamicImage::ImageLuma16(gray) = decoded else {
+        return Err(format(format!(
+            "expected a 16-bit grayscale depth image, found {:?}",
+            decoded.color()
+        )));
+    };
+    let (width, height) = gray.dimensions();
+    let depth = gray
+        .into_raw()
+        .into_iter()
+        .map(|mm| f32::from(mm) * 1e-3)
+        .collect();
+    Ok(DepthImage {
+        width,
+        height,
+        depth,
+    })
+}
+
+/// Reads a whitespace-separated text matrix of `rows × cols` numbers.
+fn read_matrix(path: &Path, rows: usize, cols: usize) -> Result<Vec<f64>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut values = Vec::with_capacity(rows * cols);
+    for (line_index, line) in text.lines().enumerate() {
+        for field in line.split_whitespace() {
+            let value: f64 = field.parse().map_err(|_| Error::Parse {
+                path: path.to_path_buf(),
+                line: line_index + 1,
+                message: format!("`{field}` is not a number"),
+            })?;
+            values.push(value);
+        }
+    }
+    if values.len() != rows * cols {
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: 0,
+            message: format!("expected {rows}×{cols} numbers, found {}", values.len()),
+        });
+    }
+    Ok(values)
+}
+
+/// Reads a `frame-N.pose.txt`: a row-major 4×4 `world_from_camera` matrix.
+pub fn read_pose_txt(path: &Path) -> Result<Isometry3<f64>> {
+    let values = read_matrix(path, 4, 4)?;
+    pose_from_matrix(&Matrix4::from_row_slice(&values))
+}
+
+/// Reads a `camera-intrinsics.txt` (row-major 3×3 K) for images of `width × height`.
+pub fn read_intrinsics_txt(path: &Path, width: u32, height: u32) -> Result<PinholeIntrinsics> {
+    let k = read_matrix(path, 3, 3)?;
+    if k[1].abs() > 1e-9 || k[3].abs() > 1e-9 || k[6].abs() > 1e-9 || k[7].abs() > 1e-9 {
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: 0,
+            message: "K must be upper triangular without skew: [fx 0 cx; 0 fy cy; 0 0 1]".into(),
+        });
+    }
+    PinholeIntrinsics::new(width, height, k[0], k[4], k[2], k[5])
+}
+
+/// Kinect (structured light) depth noise, σ in metres at depth `z` (Nguyen, Izadi and Lovell,
+/// "Modeling Kinect Sensor Noise", 3DIMPVT 2012, axial model).
+pub fn kinect_sigma(z: f32) -> f32 {
+    0.0012 + 0.0019 * (z - 0.4) * (z - 0.4)
+}
+
+/// Turns a Kinect depth image into an interval depth image: `P± = z ± 2σ(z)` and confidence
+/// `max(1 - 0.05 (P+ - P-), 0)` (the depth stage's `C = 100 - a (P+ - P-)` with `a = 5` per
+/// metre, scaled to `[0, 1]`).
+pub fn kinect_interval_image(depth: &DepthImage) -> Result<IntervalDepthImage> {
+    IntervalDepthImage::from_depth(depth.width, depth.height, &depth.depth, |z| {
+        let half = 2.0 * kinect_sigma(z);
+        let near = (z - half).max(f32::MIN_POSITIVE);
+        let far = z + half;
+        (near, far, (1.0 - 0.05 * (far - near)).max(0.0))
+    })
+}

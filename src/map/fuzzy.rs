@@ -1,0 +1,261 @@
+use nalgebra::Point3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::VoxelMap;
+use super::config::FuzzyConfig;
+use crate::error::{Error, Result};
+use crate::integrate::{
+    DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
+    cloud_evidence, depth_evidence,
+};
+use crate::measures::{MeasureConfig, Measures, Memberships, VoxelClass};
+use crate::ops::TConorm;
+use crate::storage::{Block, BlockGrid, KeyBox, Resolution, VoxelKey};
+
+/// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
+/// and how free (μE), each aggregated from evidence with a t-conorm `S`:
+/// `μO ← S(μO, o)`, `μE ← S(μE, e)`.
+///
+/// Because every t-conorm is commutative and associative, the map does not depend on the order
+/// of observations, and two maps of the same area [`merge`](FuzzyMap::merge) exactly.
+///
+/// ```
+/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap};
+/// use nalgebra::Point3;
+///
+/// let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
+/// let cloud = PointCloud::new(Point3::origin(), vec![Point3::new(2.0, 0.05, 0.05)])?;
+/// map.integrate_cloud(&cloud, &IntegrationOptions::default())?;
+/// assert_eq!(map.class_at_point(&Point3::new(2.0, 0.05, 0.05))?, VoxelClass::Occupied);
+/// assert_eq!(map.class_at_point(&Point3::new(1.0, 0.05, 0.05))?, VoxelClass::Free);
+/// # Ok::<(), fuzzyvox::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct FuzzyMap {
+    config: FuzzyConfig,
+    grid: BlockGrid<Memberships>,
+}
+
+/// Voxel counts per class over a map's allocated blocks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct VoxelCounts {
+    /// Occupied voxels.
+    pub occupied: usize,
+    /// Free voxels.
+    pub free: usize,
+    /// Ambiguous voxels.
+    pub ambiguous: usize,
+    /// Voxels inside allocated blocks that are unknown (including those no evidence reached).
+    pub unknown: usize,
+}
+
+impl VoxelCounts {
+    /// The count for one class.
+    pub fn get(&self, class: VoxelClass) -> usize {
+        match class {
+            VoxelClass::Occupied => self.occupied,
+            VoxelClass::Free => self.free,
+            VoxelClass::Ambiguous => self.ambiguous,
+            VoxelClass::Unknown => self.unknown,
+        }
+    }
+}
+
+impl FuzzyMap {
+    /// An empty map.
+    pub fn new(config: FuzzyConfig) -> Result<Self> {
+        Ok(Self {
+            config: config.validate()?,
+            grid: BlockGrid::new(),
+        })
+    }
+
+    /// The map's configuration.
+    pub fn config(&self) -> &FuzzyConfig {
+        &self.config
+    }
+
+    /// The aggregation operator.
+    pub fn operator(&self) -> TConorm {
+        self.config.operator
+    }
+
+    /// The underlying block storage (read-only).
+    pub fn grid(&self) -> &BlockGrid<Memberships> {
+        &self.grid
+    }
+
+    /// Folds one scan's evidence into the map: one `S` per voxel and membership. Returns the
+    /// number of voxels that received evidence.
+    ///
+    /// Within one scan a voxel that holds an end point is not also cleared by the rays that
+    /// graze it: the scan's free evidence is "free and not occupied", `e · (1 - o)` (product
+    /// t-norm with the standard complement). This is the fuzzy form of OctoMap's rule that a
+    /// voxel both hit and passed in one scan counts as hit; conflict between *different* scans
+    /// still shows as ambiguity.
+    pub fn apply_evidence(&mut self, evidence: &ScanEvidence) -> usize {
+        self.fold(evidence, |e: &Evidence| {
+            (e.occupied, e.free * (1.0 - e.occupied))
+        })
+    }
+
+    /// Merges another map of the same resolution and operator into this one, cell by cell with
+    /// `S`. The result equals inserting both maps' observations into one map, in any order.
+    pub fn merge(&mut self, other: &FuzzyMap) -> Result<()> {
+        if self.config.resolution != other.config.resolution {
+            return Err(Error::Incompatible(format!(
+                "resolutions differ ({} m and {} m)",
+                self.config.resolution.size(),
+                other.config.resolution.size()
+            )));
+        }
+        if self.config.operator != other.config.operator {
+            return Err(Error::Incompatible(format!(
+                "operators differ ({} and {})",
+                self.config.operator.family(),
+                other.config.operator.family()
+            )));
+        }
+        self.fold(&other.grid, |m: &Memberships| (m.occupied, m.free));
+        Ok(())
+    }
+
+    /// Applies `S` between every cell and the matching cell of `source`, in parallel over
+    /// blocks; each block is touched by one thread only, so the result does not depend on the
+    /// thread count.
+    fn fold<C: Copy + Default + Sync>(
+        &mut self,
+        source: &BlockGrid<C>,
+        evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
+    ) -> usize {
+        // Allocate in key order so that the storage order is the same however `source` was
+        // built.
+        for key in source.sorted_block_keys() {
+            self.grid.ensure_block(key);
+        }
+        let mut sources: Vec<Option<&Block<C>>> = vec![None; self.grid.block_count()];
+        for (key, block) in source.blocks() {
+            if let Some(position) = self.grid.position(key) {
+                sources[position] = Some(block);
+            }
+        }
+        let operator = self.config.operator;
+        let measures = self.config.measures;
+        let (_, blocks) = self.grid.blocks_mut();
+        blocks
+            .par_iter_mut()
+            .zip(sources.par_iter())
+            .map(|(block, source)| {
+                let Some(source) = source else { return 0 };
+                let mut updated = 0;
+                for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
+                    let (o, e) = evidence_of(s);
+                    if o > 0.0 {
+                        cell.occupied = operator.apply(cell.occupied, o);
+                    }
+                    if e > 0.0 {
+                        cell.free = operator.apply(cell.free, e);
+                    }
+                    updated += usize::from(o > 0.0 || e > 0.0);
+                }
+                block.refresh_summary(|m| measures.classify(*m));
+                updated
+            })
+            .sum()
+    }
+
+    /// A voxel's memberships at a world point.
+    pub fn memberships_at_point(&self, point: &Point3<f64>) -> Result<Memberships> {
+        Ok(self.memberships_at(self.config.resolution.key_of(point)?))
+    }
+
+    /// Every measure at a world point.
+    pub fn measures_at_point(&self, point: &Point3<f64>) -> Result<Measures> {
+        Ok(self.measures_at(self.config.resolution.key_of(point)?))
+    }
+
+    /// The class at a world point.
+    pub fn class_at_point(&self, point: &Point3<f64>) -> Result<VoxelClass> {
+        Ok(self.class_at(self.config.resolution.key_of(point)?))
+    }
+
+    /// Voxel counts per class over the allocated blocks, from the block summaries.
+    pub fn counts(&self) -> VoxelCounts {
+        let mut counts = VoxelCounts::default();
+        for (_, block) in self.grid.blocks() {
+            counts.occupied += block.summary.get(VoxelClass::Occupied);
+            counts.free += block.summary.get(VoxelClass::Free);
+            counts.ambiguous += block.summary.get(VoxelClass::Ambiguous);
+            counts.unknown += block.summary.get(VoxelClass::Unknown);
+        }
+        counts
+    }
+
+    /// Whether any voxel in `region` is of class `class` (voxels of unallocated blocks are
+    /// unknown), answered from block summaries where possible.
+    pub fn any_in_box(&self, region: &KeyBox, class: VoxelClass) -> bool {
+        let measures = self.config.measures;
+        self.grid
+            .any_in_box(region, class, |m| measures.classify(*m))
+    }
+
+    /// Every allocated voxel with its memberships.
+    pub fn cells(&self) -> impl Iterator<Item = (VoxelKey, Memberships)> + '_ {
+        self.grid.cells().map(|(k, m)| (k, *m))
+    }
+
+    /// Heap memory held by the map, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.grid.memory_bytes()
+    }
+
+    /// Rebuilds a map from its configuration and storage (used by the file reader, which has
+    /// validated both).
+    pub(crate) fn from_parts(config: FuzzyConfig, mut grid: BlockGrid<Memberships>) -> Self {
+        let measures = config.measures;
+        let (_, blocks) = grid.blocks_mut();
+        blocks
+            .par_iter_mut()
+            .for_each(|b| b.refresh_summary(|m| measures.classify(*m)));
+        Self { config, grid }
+    }
+}
+
+impl VoxelMap for FuzzyMap {
+    fn resolution(&self) -> Resolution {
+        self.config.resolution
+    }
+
+    fn measure_config(&self) -> &MeasureConfig {
+        &self.config.measures
+    }
+
+    fn memberships_at(&self, key: VoxelKey) -> Memberships {
+        self.grid.cell(key).copied().unwrap_or_default()
+    }
+
+    fn integrate_cloud(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        let c = &self.config;
+        let (evidence, mut stats) =
+            cloud_evidence(cloud, &c.resolution, &c.evidence, &c.operator, options)?;
+        stats.voxels_updated = self.apply_evidence(&evidence);
+        Ok(stats)
+    }
+
+    fn integrate_depth(
+        &mut self,
+        frame: &DepthFrame,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        let c = &self.config;
+        let (evidence, mut stats) =
+            depth_evidence(frame, &c.resolution, &c.evidence, &c.operator, options)?;
+        stats.voxels_updated = self.apply_evidence(&evidence);
+        Ok(stats)
+    }
+}

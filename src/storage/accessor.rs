@@ -1,0 +1,83 @@
+use super::block::Block;
+use super::grid::BlockGrid;
+use super::key::{BlockKey, VoxelKey};
+
+/// Reads cells through a cache of the last block visited, so that runs of neighbouring reads
+/// (a ray walk, a kernel) skip the hash lookup.
+pub struct Accessor<'a, C> {
+    grid: &'a BlockGrid<C>,
+    last: Option<(BlockKey, Option<&'a Block<C>>)>,
+}
+
+impl<'a, C: Copy + Default> Accessor<'a, C> {
+    /// An accessor over `grid`.
+    pub fn new(grid: &'a BlockGrid<C>) -> Self {
+        Self { grid, last: None }
+    }
+
+    /// The cell at `key`, if its block is allocated.
+    #[inline]
+    pub fn get(&mut self, key: VoxelKey) -> Option<&'a C> {
+        let block_key = key.block();
+        let block = match self.last {
+            Some((cached, block)) if cached == block_key => block,
+            _ => {
+                let block = self.grid.block(block_key);
+                self.last = Some((block_key, block));
+                block
+            }
+        };
+        block.map(|b| &b.cells[key.cell_index()])
+    }
+}
+
+/// Writes cells through a cache of the last block visited, allocating blocks on demand.
+pub struct AccessorMut<'a, C> {
+    grid: &'a mut BlockGrid<C>,
+    last: Option<(BlockKey, usize)>,
+}
+
+impl<'a, C: Copy + Default> AccessorMut<'a, C> {
+    /// A writing accessor over `grid`.
+    pub fn new(grid: &'a mut BlockGrid<C>) -> Self {
+        Self { grid, last: None }
+    }
+
+    /// The cell at `key`, allocating its block when needed.
+    #[inline]
+    pub fn get_or_insert(&mut self, key: VoxelKey) -> &mut C {
+        let block_key = key.block();
+        let position = match self.last {
+            Some((cached, position)) if cached == block_key => position,
+            _ => {
+                let position = self.grid.ensure_block(block_key);
+                self.last = Some((block_key, position));
+                position
+            }
+        };
+        &mut self.grid.block_at_mut(position).cells[key.cell_index()]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accessors_agree_with_the_grid() {
+        let mut grid = BlockGrid::<u32>::new();
+        {
+            let mut acc = AccessorMut::new(&mut grid);
+            for i in -20..20 {
+                *acc.get_or_insert(VoxelKey::new(i, i / 2, -i)) += 1 + i as u32 % 3;
+            }
+        }
+        let mut read = Accessor::new(&grid);
+        for i in -20..20 {
+            let key = VoxelKey::new(i, i / 2, -i);
+            assert_eq!(read.get(key), grid.cell(key));
+            assert_eq!(*read.get(key).unwrap(), 1 + i as u32 % 3);
+        }
+        assert_eq!(read.get(VoxelKey::new(500, 0, 0)), None);
+    }
+}

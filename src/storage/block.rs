@@ -1,0 +1,57 @@
+use serde::{Deserialize, Serialize};
+
+use crate::measures::VoxelClass;
+
+/// Cells along one edge of a block.
+pub const BLOCK_SIDE: usize = 8;
+/// Cells in one block.
+pub const BLOCK_CELLS: usize = BLOCK_SIDE * BLOCK_SIDE * BLOCK_SIDE;
+
+/// How many cells of a block fall in each [`VoxelClass`]: the coarse summary that answers
+/// "is anything occupied (or unknown) here?" without visiting the cells.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ClassCounts([u16; 4]);
+
+impl ClassCounts {
+    /// Counts the classes of `cells` with `classify`.
+    pub fn of<C>(cells: &[C], classify: impl Fn(&C) -> VoxelClass) -> Self {
+        let mut counts = [0u16; 4];
+        for cell in cells {
+            counts[classify(cell).index()] += 1;
+        }
+        Self(counts)
+    }
+
+    /// Cells of class `class`.
+    #[inline]
+    pub fn get(&self, class: VoxelClass) -> usize {
+        usize::from(self.0[class.index()])
+    }
+}
+
+/// A dense 8×8×8 block of cells with its class counts.
+///
+/// Cell `(x, y, z)` (each 0..8) sits at index `x + 8 y + 64 z`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block<C> {
+    /// The cells, x fastest.
+    pub cells: [C; BLOCK_CELLS],
+    /// Class counts of `cells`; kept current by the map that owns the block.
+    pub summary: ClassCounts,
+}
+
+impl<C: Copy + Default> Default for Block<C> {
+    fn default() -> Self {
+        Self {
+            cells: [C::default(); BLOCK_CELLS],
+            summary: ClassCounts::default(),
+        }
+    }
+}
+
+impl<C> Block<C> {
+    /// Recomputes the class counts after the cells changed.
+    pub fn refresh_summary(&mut self, classify: impl Fn(&C) -> VoxelClass) {
+        self.summary = ClassCounts::of(&self.cells, classify);
+    }
+}

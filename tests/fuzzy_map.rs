@@ -1,0 +1,299 @@
+//! The dual-set fuzzy map's laws: order independence, exact merges, memberships in [0, 1],
+//! thread-count independence, and what rays and frusta do to voxels.
+
+mod common;
+
+use common::{room_scan, wall_frame};
+use fuzzyvox::{
+    Family, FuzzyConfig, FuzzyMap, IntegrationOptions, Memberships, TConorm, VoxelClass, VoxelMap,
+};
+use nalgebra::Point3;
+
+fn config(family: Family) -> FuzzyConfig {
+    FuzzyConfig::new(0.2)
+        .unwrap()
+        .with_operator(TConorm::new(family).unwrap())
+}
+
+fn scans() -> Vec<fuzzyvox::PointCloud> {
+    [
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(1.0, -1.5, 0.5),
+        Point3::new(-2.0, 1.0, 1.0),
+        Point3::new(2.5, 2.5, 0.0),
+        Point3::new(-1.0, -2.0, 2.0),
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(i, o)| room_scan(o, 3000, i as u64))
+    .collect()
+}
+
+fn build(config: FuzzyConfig, scans: &[&fuzzyvox::PointCloud]) -> FuzzyMap {
+    let mut map = FuzzyMap::new(config).unwrap();
+    for scan in scans {
+        map.integrate_cloud(scan, &IntegrationOptions::default())
+            .unwrap();
+    }
+    map
+}
+
+fn max_difference(a: &FuzzyMap, b: &FuzzyMap) -> f32 {
+    assert_eq!(a.grid().block_count(), b.grid().block_count());
+    a.cells()
+        .map(|(key, m)| {
+            let n = b.memberships_at(key);
+            (m.occupied - n.occupied).abs().max((m.free - n.free).abs())
+        })
+        .fold(0.0, f32::max)
+}
+
+const FAMILIES: [Family; 5] = [
+    Family::Product,
+    Family::Minimum,
+    Family::Lukasiewicz,
+    Family::Dombi { lambda: 2.0 },
+    Family::Hamacher { gamma: 0.5 },
+];
+
+#[test]
+fn insertion_order_does_not_matter() {
+    let scans = scans();
+    for family in FAMILIES {
+        let forward: Vec<_> = scans.iter().collect();
+        let shuffled = vec![&scans[3], &scans[0], &scans[4], &scans[2], &scans[1]];
+        let reversed: Vec<_> = scans.iter().rev().collect();
+        let a = build(config(family), &forward);
+        let b = build(config(family), &shuffled);
+        let c = build(config(family), &reversed);
+        assert!(a.counts().occupied > 100, "{family}: too little mapped");
+        assert!(max_difference(&a, &b) < 1e-5, "{family}: shuffled differs");
+        assert!(max_difference(&a, &c) < 1e-5, "{family}: reversed differs");
+    }
+}
+
+#[test]
+fn merge_equals_sequential_insertion() {
+    let scans = scans();
+    for family in FAMILIES {
+        let all: Vec<_> = scans.iter().collect();
+        let sequential = build(config(family), &all);
+        let mut left = build(config(family), &all[..2]);
+        let right = build(config(family), &all[2..]);
+        left.merge(&right).unwrap();
+        assert!(max_difference(&sequential, &left) < 1e-5, "{family}");
+        // And the other way round.
+        let mut right = build(config(family), &all[2..]);
+        right.merge(&build(config(family), &all[..2])).unwrap();
+        assert!(max_difference(&sequential, &right) < 1e-5, "{family}");
+    }
+}
+
+#[test]
+fn merge_rejects_incompatible_maps() {
+    let mut a = FuzzyMap::new(config(Family::Product)).unwrap();
+    let b = FuzzyMap::new(config(Family::Minimum)).unwrap();
+    assert!(a.merge(&b).is_err());
+    let c = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    assert!(a.merge(&c).is_err());
+}
+
+#[test]
+fn memberships_stay_in_the_unit_interval() {
+    let scans = scans();
+    for family in [
+        Family::Product,
+        Family::Lukasiewicz,
+        Family::Drastic,
+        Family::Einstein,
+        Family::Yager { p: 0.3 },
+        Family::Frank { s: 100.0 },
+        Family::AczelAlsina { p: 3.0 },
+        Family::SchweizerSklar { p: -2.0 },
+    ] {
+        let mut map = FuzzyMap::new(config(family)).unwrap();
+        for _ in 0..3 {
+            for scan in &scans {
+                map.integrate_cloud(scan, &IntegrationOptions::default())
+                    .unwrap();
+            }
+            map.integrate_depth(
+                &wall_frame(Point3::new(0.0, 0.0, 0.5), 3.9),
+                &Default::default(),
+            )
+            .unwrap();
+        }
+        for (_, m) in map.cells() {
+            assert!((0.0..=1.0).contains(&m.occupied), "{family}: {m:?}");
+            assert!((0.0..=1.0).contains(&m.free), "{family}: {m:?}");
+        }
+    }
+}
+
+#[test]
+fn saved_bytes_do_not_depend_on_the_thread_count() {
+    let scans = scans();
+    let frame = wall_frame(Point3::new(-1.0, 0.3, 0.5), 3.9);
+    let bytes: Vec<Vec<u8>> = [1, 2, 4]
+        .into_iter()
+        .map(|threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut map = FuzzyMap::new(config(Family::Product)).unwrap();
+                for scan in &scans {
+                    map.integrate_cloud(scan, &IntegrationOptions::default())
+                        .unwrap();
+                }
+                map.integrate_depth(&frame, &IntegrationOptions::default())
+                    .unwrap();
+                map.to_bytes()
+            })
+        })
+        .collect();
+    assert!(bytes[0].len() > 10_000);
+    assert_eq!(bytes[0], bytes[1], "1 vs 2 threads");
+    assert_eq!(bytes[0], bytes[2], "1 vs 4 threads");
+}
+
+#[test]
+fn save_load_round_trip() {
+    let scans = scans();
+    let map = build(config(Family::Dombi { lambda: 1.5 }), &[&scans[0]]);
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-roundtrip-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("map.fvx");
+    map.save(&path).unwrap();
+    let loaded = FuzzyMap::load(&path).unwrap();
+    assert_eq!(loaded.to_bytes(), map.to_bytes());
+    assert_eq!(loaded.counts(), map.counts());
+    assert_eq!(loaded.config(), map.config());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_ray_frees_its_path_and_occupies_its_end() {
+    let mut map = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    let end = Point3::new(2.05, 0.05, 0.05);
+    let cloud = fuzzyvox::PointCloud::new(Point3::new(0.05, 0.05, 0.05), vec![end]).unwrap();
+    let stats = map.integrate_cloud(&cloud, &Default::default()).unwrap();
+    assert_eq!(stats.integrated, 1);
+    let end_m = map.memberships_at_point(&end).unwrap();
+    assert!((end_m.occupied - 0.7).abs() < 1e-6, "{end_m:?}");
+    assert_eq!(end_m.free, 0.0);
+    for i in 0..18 {
+        let p = Point3::new(0.05 + 0.1 * f64::from(i), 0.05, 0.05);
+        let m = map.memberships_at_point(&p).unwrap();
+        assert!(
+            (m.free - 0.6).abs() < 1e-6 && m.occupied == 0.0,
+            "{i}: {m:?}"
+        );
+    }
+    // Beyond the end: nothing known.
+    let behind = map
+        .memberships_at_point(&Point3::new(2.5, 0.05, 0.05))
+        .unwrap();
+    assert_eq!(behind, Memberships::default());
+}
+
+#[test]
+fn max_range_cuts_rays_and_only_clears() {
+    let mut map = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    let cloud =
+        fuzzyvox::PointCloud::new(Point3::origin(), vec![Point3::new(10.05, 0.05, 0.05)]).unwrap();
+    let options = IntegrationOptions {
+        max_range: Some(3.0),
+    };
+    let stats = map.integrate_cloud(&cloud, &options).unwrap();
+    assert_eq!(stats.clipped, 1);
+    assert_eq!(map.counts().occupied, 0);
+    assert_eq!(
+        map.class_at_point(&Point3::new(2.5, 0.0, 0.0)).unwrap(),
+        VoxelClass::Free
+    );
+    assert_eq!(
+        map.class_at_point(&Point3::new(5.0, 0.0, 0.0)).unwrap(),
+        VoxelClass::Unknown
+    );
+}
+
+#[test]
+fn confidence_weights_evidence_as_fractional_observations() {
+    // Two observations at confidence 0.5 equal one at confidence 1 (probabilistic sum).
+    let point = Point3::new(1.05, 0.05, 0.05);
+    let mut half = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    let weak = fuzzyvox::PointCloud::new(Point3::origin(), vec![point])
+        .unwrap()
+        .with_confidence(vec![0.5])
+        .unwrap();
+    half.integrate_cloud(&weak, &Default::default()).unwrap();
+    half.integrate_cloud(&weak, &Default::default()).unwrap();
+    let mut full = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    let sure = fuzzyvox::PointCloud::new(Point3::origin(), vec![point]).unwrap();
+    full.integrate_cloud(&sure, &Default::default()).unwrap();
+    assert!(max_difference(&half, &full) < 1e-5);
+    // Confidence zero changes nothing.
+    let mut none = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    let zero = fuzzyvox::PointCloud::new(Point3::origin(), vec![point])
+        .unwrap()
+        .with_confidence(vec![0.0])
+        .unwrap();
+    none.integrate_cloud(&zero, &Default::default()).unwrap();
+    assert_eq!(none.counts().occupied + none.counts().free, 0);
+}
+
+#[test]
+fn frustum_frees_space_in_front_occupies_the_wall_and_leaves_behind_unknown() {
+    let mut map = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    let frame = wall_frame(Point3::new(0.0, 0.0, 0.5), 3.0);
+    let stats = map.integrate_depth(&frame, &Default::default()).unwrap();
+    assert!(stats.integrated > 3000 && stats.skipped > 0);
+    // One frame of a ±5 % interval spreads its occupied evidence thin: some, but not yet
+    // enough for the occupied class.
+    let wall = Point3::new(3.05, 0.05, 0.55);
+    let once = map.memberships_at_point(&wall).unwrap();
+    assert!(once.occupied > 0.1 && once.occupied < 0.3, "{once:?}");
+    for _ in 0..3 {
+        map.integrate_depth(&frame, &Default::default()).unwrap();
+    }
+    let class = |x: f64| map.class_at_point(&Point3::new(x, 0.05, 0.55)).unwrap();
+    assert_eq!(class(1.0), VoxelClass::Free);
+    assert_eq!(class(2.0), VoxelClass::Free);
+    assert_eq!(class(3.05), VoxelClass::Occupied);
+    assert_eq!(class(3.6), VoxelClass::Unknown);
+    assert_eq!(class(-0.5), VoxelClass::Unknown);
+    // Outside the field of view (±38° horizontally): unknown.
+    assert_eq!(
+        map.class_at_point(&Point3::new(1.0, 1.5, 0.5)).unwrap(),
+        VoxelClass::Unknown
+    );
+}
+
+#[test]
+fn box_queries_agree_with_cell_scans() {
+    let scans = scans();
+    let map = build(config(Family::Product), &[&scans[0], &scans[1]]);
+    let r = map.resolution();
+    for (lo, hi) in [
+        ([-1.0, -1.0, -0.5], [1.0, 1.0, 0.5]),
+        ([3.5, -4.5, -1.5], [4.5, 4.5, 3.5]),
+        ([-0.3, -0.3, -0.3], [0.3, 0.3, 0.3]),
+        ([10.0, 10.0, 10.0], [11.0, 11.0, 11.0]),
+    ] {
+        let region =
+            fuzzyvox::KeyBox::from_points(&r, &Point3::from(lo), &Point3::from(hi)).unwrap();
+        for class in VoxelClass::ALL {
+            let mut expected = false;
+            for x in region.min.x..=region.max.x {
+                for y in region.min.y..=region.max.y {
+                    for z in region.min.z..=region.max.z {
+                        expected |= map.class_at(fuzzyvox::VoxelKey::new(x, y, z)) == class;
+                    }
+                }
+            }
+            assert_eq!(map.any_in_box(&region, class), expected, "{lo:?} {class:?}");
+        }
+    }
+}
