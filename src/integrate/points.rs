@@ -49,8 +49,9 @@ pub fn cloud_evidence(
             resolution: resolution.size(),
         });
     }
-    // `fold` keeps one partial scan per piece of work that rayon schedules (a few per thread);
-    // `max` combines them exactly, so the split does not change the result.
+    // `fold` keeps one partial scan per piece of work that rayon schedules (a few per thread,
+    // balanced by work stealing); `max` combines them exactly, so neither the split nor the
+    // thread count changes the result.
     let evidence = rays
         .par_chunks(CHUNK)
         .enumerate()
@@ -126,6 +127,19 @@ impl Ray {
         let sigma = self.range * model.angular_resolution;
         let reach = 2.0 * sigma;
         let kernel = !self.clipped && reach > 0.5 * resolution.size();
+        // Voxels inside this ray's own occupied kernel get no free evidence from it. Only voxels
+        // within a few key steps of the end voxel can be that close, so the distance is only
+        // computed for those.
+        let near_end = if kernel {
+            3 * (EvidenceModel::MAX_KERNEL_VOXELS + 1)
+        } else {
+            -1
+        };
+        // The walk takes exactly as many steps as the keys differ, so a countdown tells how far
+        // (in key steps) each visited voxel is from the end voxel.
+        let mut steps_to_end = (origin_key.x - end_key.x).abs()
+            + (origin_key.y - end_key.y).abs()
+            + (origin_key.z - end_key.z).abs();
         walk_ray(
             resolution,
             &self.origin,
@@ -133,8 +147,9 @@ impl Ray {
             origin_key,
             end_key,
             |key| {
-                // Voxels inside this ray's own occupied kernel get no free evidence from it.
-                if kernel && (resolution.center(key) - self.end).norm() <= reach {
+                let close = steps_to_end <= near_end;
+                steps_to_end -= 1;
+                if close && (resolution.center(key) - self.end).norm() <= reach {
                     return;
                 }
                 raise(acc, key, 0.0, free);

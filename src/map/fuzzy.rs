@@ -129,10 +129,17 @@ impl FuzzyMap {
         source: &BlockGrid<C>,
         evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
     ) -> usize {
-        // Allocate in key order so that the storage order is the same however `source` was
-        // built.
-        for key in source.sorted_block_keys() {
-            self.grid.ensure_block(key);
+        // Allocate missing blocks in key order, so that the storage order is the same however
+        // `source` was built; the (page-faulting) allocations themselves run in parallel.
+        let missing: Vec<_> = source
+            .sorted_block_keys()
+            .into_iter()
+            .filter(|&key| self.grid.position(key).is_none())
+            .collect();
+        let fresh: Vec<Box<Block<Memberships>>> =
+            missing.par_iter().map(|_| Box::default()).collect();
+        for (key, block) in missing.into_iter().zip(fresh) {
+            self.grid.insert_block(key, block);
         }
         let mut sources: Vec<Option<&Block<C>>> = vec![None; self.grid.block_count()];
         for (key, block) in source.blocks() {

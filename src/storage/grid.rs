@@ -74,8 +74,14 @@ impl<C: Copy + Default> BlockGrid<C> {
 
     /// Inserts (or replaces) a whole block.
     pub fn insert_block(&mut self, key: BlockKey, block: Box<Block<C>>) {
-        let i = self.ensure_block(key);
-        self.blocks[i] = block;
+        match self.index.get(&key) {
+            Some(&i) => self.blocks[i] = block,
+            None => {
+                self.index.insert(key, self.blocks.len());
+                self.keys.push(key);
+                self.blocks.push(block);
+            }
+        }
     }
 
     /// The block at a storage position.
