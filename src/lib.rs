@@ -47,7 +47,10 @@ pub use integrate::{
     DepthFrame, Evidence, EvidenceModel, IntegrationOptions, IntegrationStats, IntervalDepthImage,
     PointCloud, ScanEvidence,
 };
-pub use map::{FuzzyConfig, FuzzyMap, VoxelCounts, VoxelMap};
+pub use map::{
+    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
+    VoxelCounts, VoxelMap,
+};
 pub use measures::{ClassThresholds, MeasureConfig, Measures, Memberships, VoxelClass};
 pub use ops::{Complement, Family, Hedge, TConorm, TNorm};
 pub use storage::{BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};

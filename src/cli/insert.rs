@@ -1,40 +1,48 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
-use fuzzyvox::io::read_text_cloud;
-use fuzzyvox::{Family, FuzzyConfig, FuzzyMap, IntegrationOptions, TConorm, VoxelMap};
+use fuzzyvox::{
+    AlphaConfig, AlphaCutMap, AnyMap, Family, FuzzyConfig, FuzzyMap, IntegrationOptions,
+    IntegrationStats, LogOddsConfig, LogOddsMap, TConorm,
+};
 use serde_json::json;
 
-/// Integrate a point cloud into a new map and report what it holds.
+/// Integrate point clouds into a new map and report what it holds.
 ///
-/// The cloud is a text file with one `x y z [confidence]` per line (metres, world frame,
-/// confidence in [0, 1]).
+/// Inputs: text clouds (`x y z [confidence]` per line; any extension but the two below),
+/// OctoMap scan graphs (`.graph`) and OctoMap text logs (`.log`, `NODE x y z roll pitch yaw`
+/// then points in the sensor frame). Each graph or log node is one scan from its own pose.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
     fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
-    fuzzyvox insert --cloud cloud.xyz --res 0.05 --origin 0,0,1.2 --max-range 20 --op dombi:2 --json")]
+    fuzzyvox insert --cloud scan.dat --res 0.05 --model logodds --json\n  \
+    fuzzyvox insert --cloud cloud.xyz --res 0.05 --origin 0,0,1.2 --max-range 20 --op dombi:2 --json\n  \
+    fuzzyvox insert --cloud confident.xyz --res 0.1 --model alpha --cuts 10 --out alpha.fvx")]
 pub struct InsertArgs {
-    /// Text point cloud (`x y z [confidence]` per line).
+    /// Input scans: a text cloud, an OctoMap `.graph` or an OctoMap `.log`.
     #[arg(long)]
     cloud: PathBuf,
     /// Voxel size in metres.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     res: f64,
-    /// Sensor origin as X,Y,Z (metres).
+    /// Sensor origin of a text cloud as X,Y,Z (metres).
     #[arg(long, value_parser = super::parse_point, default_value = "0,0,0", allow_hyphen_values = true)]
     origin: nalgebra::Point3<f64>,
     /// Cut rays longer than this (metres); the cut part clears free space only.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     max_range: Option<f64>,
     /// Map model.
     #[arg(long, value_enum, default_value_t = Model::Fuzzy)]
     model: Model,
-    /// Aggregation t-conorm as NAME[:PARAM], e.g. product, max, lukasiewicz, dombi:2,
-    /// hamacher:0.5, yager:2, frank:3, einstein, aczel-alsina:2, schweizer-sklar:-1.
+    /// Aggregation t-conorm of the fuzzy model as NAME[:PARAM], e.g. product, max, lukasiewicz,
+    /// dombi:2, hamacher:0.5, yager:2, frank:3, einstein, aczel-alsina:2, schweizer-sklar:-1.
     #[arg(long, default_value = "product")]
     op: String,
+    /// Number of confidence cuts of the alpha model.
+    #[arg(long, default_value_t = 10)]
+    cuts: u32,
     /// Write the map here (native format).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -43,70 +51,103 @@ pub struct InsertArgs {
     json: bool,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Model {
     /// The dual-set fuzzy map.
     Fuzzy,
+    /// The standard log-odds map (OctoMap semantics).
+    Logodds,
+    /// The alpha-cut log-odds map (needs per-point confidence).
+    Alpha,
 }
 
 pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     let family: Family = args.op.parse().context("--op")?;
-    let config = FuzzyConfig::new(args.res)
-        .context("--res")?
-        .with_operator(TConorm::new(family)?);
-    let cloud = read_text_cloud(&args.cloud, args.origin)
-        .with_context(|| format!("reading the cloud {}", args.cloud.display()))?;
-    let mut map = FuzzyMap::new(config)?;
+    if args.model != Model::Fuzzy && args.op != "product" {
+        bail!("--op applies to the fuzzy model only");
+    }
+    let mut map = match args.model {
+        Model::Fuzzy => AnyMap::Fuzzy(FuzzyMap::new(
+            FuzzyConfig::new(args.res)
+                .context("--res")?
+                .with_operator(TConorm::new(family)?),
+        )?),
+        Model::Logodds => AnyMap::LogOdds(LogOddsMap::new(
+            LogOddsConfig::new(args.res).context("--res")?,
+        )?),
+        Model::Alpha => {
+            let mut config = AlphaConfig::new(args.res).context("--res")?;
+            config.cuts = args.cuts;
+            AnyMap::Alpha(AlphaCutMap::new(config).context("--cuts")?)
+        }
+    };
+    let scans = super::input::read_scans(&args.cloud, args.origin)?;
+    if args.model == Model::Alpha && scans.iter().any(|s| s.confidence().is_none()) {
+        bail!(
+            "the alpha model needs a confidence per point, and {} has none: give a text cloud \
+             with `x y z confidence` lines (confidence in [0, 1]), or use --model logodds",
+            args.cloud.display()
+        );
+    }
     let options = IntegrationOptions {
         max_range: args.max_range,
     };
     let started = Instant::now();
-    let stats = map
-        .integrate_cloud(&cloud, &options)
-        .context("integrating the cloud")?;
+    let mut total = IntegrationStats::default();
+    for (index, scan) in scans.iter().enumerate() {
+        let stats = map
+            .as_map_mut()
+            .integrate_cloud(scan, &options)
+            .with_context(|| format!("integrating scan {index}"))?;
+        total.integrated += stats.integrated;
+        total.skipped += stats.skipped;
+        total.clipped += stats.clipped;
+        total.voxels_updated += stats.voxels_updated;
+    }
     let seconds = started.elapsed().as_secs_f64();
-    let counts = map.counts();
+    let points: usize = scans.iter().map(|s| s.len()).sum();
+    let view = map.as_map();
+    let counts = view.counts();
     if let Some(out) = &args.out {
         map.save(out)
             .with_context(|| format!("saving the map to {}", out.display()))?;
     }
-    let model = match args.model {
-        Model::Fuzzy => "fuzzy",
-    };
+    let model = map.kind().name();
+    let operator = (args.model == Model::Fuzzy).then(|| family.to_string());
     if args.json {
         return super::print_json(&json!({
-            "points": cloud.len(),
-            "integrated": stats.integrated,
-            "skipped": stats.skipped,
-            "resolution": map.resolution().size(),
+            "points": points,
+            "scans": scans.len(),
+            "integrated": total.integrated,
+            "skipped": total.skipped,
+            "clipped": total.clipped,
+            "resolution": view.resolution().size(),
             "model": model,
-            "operator": family.to_string(),
+            "operator": operator,
             "occupied": counts.occupied,
             "free": counts.free,
             "ambiguous": counts.ambiguous,
             "unknown": counts.unknown,
-            "blocks": map.grid().block_count(),
             "insert_seconds": seconds,
-            "memory_bytes": map.memory_bytes(),
+            "memory_bytes": view.memory_bytes(),
             "out": args.out,
         }));
     }
+    let with = operator.map(|o| format!(" with {o}")).unwrap_or_default();
     println!(
-        "integrated {} of {} points ({} skipped) into a {model} map at {} m with {family} in {:.3} s",
-        stats.integrated,
-        cloud.len(),
-        stats.skipped,
-        map.resolution().size(),
-        seconds
+        "integrated {} of {points} points from {} scan(s) ({} skipped) into a {model} map at {} m{with} in {seconds:.3} s",
+        total.integrated,
+        scans.len(),
+        total.skipped,
+        view.resolution().size(),
     );
     println!(
-        "voxels: {} occupied, {} free, {} ambiguous, {} unknown in {} blocks ({:.1} MB)",
+        "voxels: {} occupied, {} free, {} ambiguous, {} unknown ({:.1} MB)",
         counts.occupied,
         counts.free,
         counts.ambiguous,
         counts.unknown,
-        map.grid().block_count(),
-        map.memory_bytes() as f64 / 1e6
+        view.memory_bytes() as f64 / 1e6
     );
     if let Some(out) = &args.out {
         println!("saved {}", out.display());

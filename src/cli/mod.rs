@@ -2,6 +2,7 @@
 //! library.
 
 mod info;
+mod input;
 mod insert;
 
 use std::process::ExitCode;

@@ -1,5 +1,6 @@
 use nalgebra::Isometry3;
 
+use super::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::geometry::{PinholeIntrinsics, validate_pose};
 
@@ -218,6 +219,24 @@ impl DepthFrame {
     /// The interval depth image.
     pub fn image(&self) -> &IntervalDepthImage {
         &self.image
+    }
+
+    /// The frame as a point cloud for ray-based maps: every valid pixel back-projected at its
+    /// `P0` depth into the world, seen from the camera centre, with its confidence.
+    pub fn to_cloud(&self) -> Result<PointCloud> {
+        let width = self.image.width() as usize;
+        let mut points = Vec::new();
+        let mut confidence = Vec::new();
+        for index in 0..self.image.depth().len() {
+            if let Some(p) = self.image.pixel(index) {
+                let (u, v) = ((index % width) as f64, (index / width) as f64);
+                let in_camera = self.intrinsics.back_project(u, v, f64::from(p.depth));
+                points.push(self.world_from_camera * in_camera);
+                confidence.push(p.confidence);
+            }
+        }
+        let origin = nalgebra::Point3::from(self.world_from_camera.translation.vector);
+        PointCloud::new(origin, points)?.with_confidence(confidence)
     }
 }
 

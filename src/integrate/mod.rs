@@ -14,12 +14,16 @@ mod cloud;
 mod depth_image;
 mod evidence;
 mod frustum;
+mod octomap_walk;
 mod points;
 mod raywalk;
+mod scan_sets;
 
 pub use cloud::PointCloud;
 pub use depth_image::{DepthFrame, IntervalDepthImage};
 pub use evidence::{Evidence, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence};
 pub use frustum::depth_evidence;
+pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;
 pub use raywalk::walk_ray;
+pub use scan_sets::{HIT, PASSED, ScanSets, scan_sets};

@@ -176,6 +176,44 @@ pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
     ))
 }
 
+/// Reads a map file and decodes it with `decode`, naming the file in any error.
+pub(crate) fn load_with<T>(
+    path: &Path,
+    decode: impl FnOnce(&[u8]) -> Result<T, FormatError>,
+) -> Result<T> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    decode(&bytes).map_err(|reason| Error::Format {
+        path: path.to_path_buf(),
+        reason,
+    })
+}
+
+/// Decodes map bytes held in memory.
+pub(crate) fn from_memory<T>(
+    bytes: &[u8],
+    decode: impl FnOnce(&[u8]) -> Result<T, FormatError>,
+) -> Result<T> {
+    decode(bytes).map_err(|reason| Error::Format {
+        path: "<memory>".into(),
+        reason,
+    })
+}
+
+/// Splits a file and checks that it holds a map of `kind`.
+pub(crate) fn body_of(bytes: &[u8], kind: MapKind) -> Result<(MapHeader, &[u8]), FormatError> {
+    let (header, body) = split(bytes)?;
+    if header.kind != kind {
+        return Err(FormatError::WrongKind {
+            expected: kind.name(),
+            found: header.kind.name().into(),
+        });
+    }
+    Ok((header, body))
+}
+
 fn family_code(family: Family) -> (u8, f64) {
     let code = match family {
         Family::Minimum => 0,

@@ -3,8 +3,10 @@
 mod atomic;
 mod cloud_text;
 mod fuzzy_file;
+mod logodds_file;
 mod mapfile;
 pub mod rgbd;
+mod stored_blocks;
 
 pub use atomic::write_atomic;
 pub use cloud_text::read_text_cloud;

@@ -1,9 +1,9 @@
 use nalgebra::Point3;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use super::VoxelMap;
 use super::config::FuzzyConfig;
+use super::counts::VoxelCounts;
 use crate::error::{Error, Result};
 use crate::integrate::{
     DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
@@ -11,7 +11,7 @@ use crate::integrate::{
 };
 use crate::measures::{MeasureConfig, Measures, Memberships, VoxelClass};
 use crate::ops::TConorm;
-use crate::storage::{Block, BlockGrid, KeyBox, Resolution, VoxelKey};
+use crate::storage::{BlockGrid, KeyBox, Resolution, VoxelKey};
 
 /// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
 /// and how free (μE), each aggregated from evidence with a t-conorm `S`:
@@ -35,31 +35,6 @@ use crate::storage::{Block, BlockGrid, KeyBox, Resolution, VoxelKey};
 pub struct FuzzyMap {
     config: FuzzyConfig,
     grid: BlockGrid<Memberships>,
-}
-
-/// Voxel counts per class over a map's allocated blocks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct VoxelCounts {
-    /// Occupied voxels.
-    pub occupied: usize,
-    /// Free voxels.
-    pub free: usize,
-    /// Ambiguous voxels.
-    pub ambiguous: usize,
-    /// Voxels inside allocated blocks that are unknown (including those no evidence reached).
-    pub unknown: usize,
-}
-
-impl VoxelCounts {
-    /// The count for one class.
-    pub fn get(&self, class: VoxelClass) -> usize {
-        match class {
-            VoxelClass::Occupied => self.occupied,
-            VoxelClass::Free => self.free,
-            VoxelClass::Ambiguous => self.ambiguous,
-            VoxelClass::Unknown => self.unknown,
-        }
-    }
 }
 
 impl FuzzyMap {
@@ -122,54 +97,29 @@ impl FuzzyMap {
     }
 
     /// Applies `S` between every cell and the matching cell of `source`, in parallel over
-    /// blocks; each block is touched by one thread only, so the result does not depend on the
-    /// thread count.
+    /// blocks (see [`BlockGrid::update_from`]).
     fn fold<C: Copy + Default + Sync>(
         &mut self,
         source: &BlockGrid<C>,
         evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
     ) -> usize {
-        // Allocate missing blocks in key order, so that the storage order is the same however
-        // `source` was built; the (page-faulting) allocations themselves run in parallel.
-        let missing: Vec<_> = source
-            .sorted_block_keys()
-            .into_iter()
-            .filter(|&key| self.grid.position(key).is_none())
-            .collect();
-        let fresh: Vec<Box<Block<Memberships>>> =
-            missing.par_iter().map(|_| Box::default()).collect();
-        for (key, block) in missing.into_iter().zip(fresh) {
-            self.grid.insert_block(key, block);
-        }
-        let mut sources: Vec<Option<&Block<C>>> = vec![None; self.grid.block_count()];
-        for (key, block) in source.blocks() {
-            if let Some(position) = self.grid.position(key) {
-                sources[position] = Some(block);
-            }
-        }
         let operator = self.config.operator;
         let measures = self.config.measures;
-        let (_, blocks) = self.grid.blocks_mut();
-        blocks
-            .par_iter_mut()
-            .zip(sources.par_iter())
-            .map(|(block, source)| {
-                let Some(source) = source else { return 0 };
-                let mut updated = 0;
-                for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
-                    let (o, e) = evidence_of(s);
-                    if o > 0.0 {
-                        cell.occupied = operator.apply(cell.occupied, o);
-                    }
-                    if e > 0.0 {
-                        cell.free = operator.apply(cell.free, e);
-                    }
-                    updated += usize::from(o > 0.0 || e > 0.0);
+        self.grid.update_from(source, |block, source| {
+            let mut updated = 0;
+            for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
+                let (o, e) = evidence_of(s);
+                if o > 0.0 {
+                    cell.occupied = operator.apply(cell.occupied, o);
                 }
-                block.refresh_summary(|m| measures.classify(*m));
-                updated
-            })
-            .sum()
+                if e > 0.0 {
+                    cell.free = operator.apply(cell.free, e);
+                }
+                updated += usize::from(o > 0.0 || e > 0.0);
+            }
+            block.refresh_summary(|m| measures.classify(*m));
+            updated
+        })
     }
 
     /// A voxel's memberships at a world point.
@@ -189,14 +139,7 @@ impl FuzzyMap {
 
     /// Voxel counts per class over the allocated blocks, from the block summaries.
     pub fn counts(&self) -> VoxelCounts {
-        let mut counts = VoxelCounts::default();
-        for (_, block) in self.grid.blocks() {
-            counts.occupied += block.summary.get(VoxelClass::Occupied);
-            counts.free += block.summary.get(VoxelClass::Free);
-            counts.ambiguous += block.summary.get(VoxelClass::Ambiguous);
-            counts.unknown += block.summary.get(VoxelClass::Unknown);
-        }
-        counts
+        VoxelCounts::of_grid(&self.grid)
     }
 
     /// Whether any voxel in `region` is of class `class` (voxels of unallocated blocks are
@@ -205,11 +148,6 @@ impl FuzzyMap {
         let measures = self.config.measures;
         self.grid
             .any_in_box(region, class, |m| measures.classify(*m))
-    }
-
-    /// Every allocated voxel with its memberships.
-    pub fn cells(&self) -> impl Iterator<Item = (VoxelKey, Memberships)> + '_ {
-        self.grid.cells().map(|(k, m)| (k, *m))
     }
 
     /// Heap memory held by the map, in bytes.
@@ -230,6 +168,23 @@ impl FuzzyMap {
 }
 
 impl VoxelMap for FuzzyMap {
+    fn counts(&self) -> VoxelCounts {
+        FuzzyMap::counts(self)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        FuzzyMap::memory_bytes(self)
+    }
+
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
+        Box::new(
+            self.grid
+                .cells()
+                .filter(|(_, m)| m.occupied > 0.0 || m.free > 0.0)
+                .map(|(k, m)| (k, *m)),
+        )
+    }
+
     fn resolution(&self) -> Resolution {
         self.config.resolution
     }

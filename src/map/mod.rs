@@ -1,10 +1,18 @@
 //! Maps: the dual-set fuzzy map, and the interface every map implements.
 
+mod alpha;
+mod any;
 mod config;
+mod counts;
 mod fuzzy;
+mod logodds;
 
+pub use alpha::{AlphaConfig, AlphaCutMap};
+pub use any::AnyMap;
 pub use config::FuzzyConfig;
-pub use fuzzy::{FuzzyMap, VoxelCounts};
+pub use counts::VoxelCounts;
+pub use fuzzy::FuzzyMap;
+pub use logodds::{LogOdds, LogOddsConfig, LogOddsMap};
 
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud};
@@ -36,6 +44,16 @@ pub trait VoxelMap {
         frame: &DepthFrame,
         options: &IntegrationOptions,
     ) -> Result<IntegrationStats>;
+
+    /// Voxel counts per class over the allocated blocks (from block summaries).
+    fn counts(&self) -> VoxelCounts;
+
+    /// Heap memory held by the map, in bytes.
+    fn memory_bytes(&self) -> usize;
+
+    /// Every observed voxel (one that some evidence reached) with its memberships, in storage
+    /// order.
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_>;
 
     /// Every measure of a voxel.
     fn measures_at(&self, key: VoxelKey) -> Measures {

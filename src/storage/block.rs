@@ -14,10 +14,22 @@ pub struct ClassCounts([u16; 4]);
 
 impl ClassCounts {
     /// Counts the classes of `cells` with `classify`.
-    pub fn of<C>(cells: &[C], classify: impl Fn(&C) -> VoxelClass) -> Self {
+    ///
+    /// Neighbouring cells often hold equal values (never observed, or updated alike by one
+    /// scan), so the class of the previous cell is reused when the value repeats.
+    pub fn of<C: PartialEq>(cells: &[C], classify: impl Fn(&C) -> VoxelClass) -> Self {
         let mut counts = [0u16; 4];
+        let mut last: Option<(&C, VoxelClass)> = None;
         for cell in cells {
-            counts[classify(cell).index()] += 1;
+            let class = match last {
+                Some((value, class)) if value == cell => class,
+                _ => {
+                    let class = classify(cell);
+                    last = Some((cell, class));
+                    class
+                }
+            };
+            counts[class.index()] += 1;
         }
         Self(counts)
     }
@@ -49,7 +61,7 @@ impl<C: Copy + Default> Default for Block<C> {
     }
 }
 
-impl<C> Block<C> {
+impl<C: PartialEq> Block<C> {
     /// Recomputes the class counts after the cells changed.
     pub fn refresh_summary(&mut self, classify: impl Fn(&C) -> VoxelClass) {
         self.summary = ClassCounts::of(&self.cells, classify);

@@ -1,3 +1,4 @@
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 use super::block::{BLOCK_CELLS, Block};
@@ -211,6 +212,41 @@ impl<C: Copy + Default> BlockGrid<C> {
                 .filter(|(key, _)| region.meets_block(*key))
                 .collect()
         }
+    }
+
+    /// Updates every block that has a counterpart in `source` with `update(block, source_block)`,
+    /// in parallel, each block by one thread (so the result does not depend on the thread
+    /// count). Missing blocks are allocated first, in key order, so the storage order does not
+    /// depend on how `source` was built. Returns the sum of what `update` returns.
+    pub fn update_from<S: Copy + Default + Sync>(
+        &mut self,
+        source: &BlockGrid<S>,
+        update: impl Fn(&mut Block<C>, &Block<S>) -> usize + Sync,
+    ) -> usize
+    where
+        C: Send + Sync,
+    {
+        let missing: Vec<BlockKey> = source
+            .sorted_block_keys()
+            .into_iter()
+            .filter(|&key| self.position(key).is_none())
+            .collect();
+        // The (page-faulting) allocations run in parallel; the insertions are cheap.
+        let fresh: Vec<Box<Block<C>>> = missing.par_iter().map(|_| Box::default()).collect();
+        for (key, block) in missing.into_iter().zip(fresh) {
+            self.insert_block(key, block);
+        }
+        let mut sources: Vec<Option<&Block<S>>> = vec![None; self.blocks.len()];
+        for (key, block) in source.blocks() {
+            if let Some(position) = self.position(key) {
+                sources[position] = Some(block);
+            }
+        }
+        self.blocks
+            .par_iter_mut()
+            .zip(sources.par_iter())
+            .map(|(block, source)| source.map_or(0, |s| update(block, s)))
+            .sum()
     }
 
     /// Heap memory held by the grid, in bytes (blocks, key list and hash index).

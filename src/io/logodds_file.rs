@@ -1,0 +1,120 @@
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::atomic::write_atomic;
+use super::mapfile::{self, MapKind};
+use super::stored_blocks::{self, StoredBlock};
+use crate::error::{FormatError, Result};
+use crate::map::{AlphaConfig, AlphaCutMap, LogOdds, LogOddsConfig, LogOddsMap};
+
+#[derive(Serialize, Deserialize)]
+struct Body<Config> {
+    config: Config,
+    blocks: Vec<StoredBlock<LogOdds>>,
+}
+
+/// A log-odds cell is either unobserved (NaN) or a finite value.
+fn valid(c: &LogOdds) -> bool {
+    c.0.is_nan() || c.0.is_finite()
+}
+
+fn decode_body<Config: serde::de::DeserializeOwned>(
+    bytes: &[u8],
+    kind: MapKind,
+    resolution_of: impl Fn(&Config) -> f64,
+) -> Result<(Config, crate::storage::BlockGrid<LogOdds>), FormatError> {
+    let (header, body) = mapfile::body_of(bytes, kind)?;
+    let invalid = FormatError::Invalid;
+    let body: Body<Config> = postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
+    if header.resolution != resolution_of(&body.config) || header.operator.is_some() {
+        return Err(invalid("header and body disagree".into()));
+    }
+    let grid = stored_blocks::restore(body.blocks, valid)?;
+    Ok((body.config, grid))
+}
+
+impl LogOddsMap {
+    /// The map as the bytes of a native map file (blocks in key order).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let config = *self.config();
+        mapfile::encode(
+            MapKind::LogOdds,
+            None,
+            config.resolution.size(),
+            &Body {
+                config,
+                blocks: stored_blocks::store(self.grid()),
+            },
+        )
+    }
+
+    /// Reads a map from the bytes of a native map file.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        mapfile::from_memory(bytes, Self::decode)
+    }
+
+    /// Saves the map atomically (temporary file, sync, rename).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        write_atomic(path.as_ref(), &self.to_bytes())
+    }
+
+    /// Loads a map saved by [`LogOddsMap::save`].
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        mapfile::load_with(path.as_ref(), Self::decode)
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, FormatError> {
+        let (config, grid) = decode_body(bytes, MapKind::LogOdds, |c: &LogOddsConfig| {
+            c.resolution.size()
+        })?;
+        let config = config
+            .validate()
+            .map_err(|e| FormatError::Invalid(e.to_string()))?;
+        Ok(LogOddsMap::from_parts(config, grid))
+    }
+}
+
+impl AlphaCutMap {
+    /// The map as the bytes of a native map file (blocks in key order).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let config = *self.config();
+        mapfile::encode(
+            MapKind::AlphaCut,
+            None,
+            config.logodds.resolution.size(),
+            &Body {
+                config,
+                blocks: stored_blocks::store(self.log_odds().grid()),
+            },
+        )
+    }
+
+    /// Reads a map from the bytes of a native map file.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        mapfile::from_memory(bytes, Self::decode)
+    }
+
+    /// Saves the map atomically (temporary file, sync, rename).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        write_atomic(path.as_ref(), &self.to_bytes())
+    }
+
+    /// Loads a map saved by [`AlphaCutMap::save`].
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        mapfile::load_with(path.as_ref(), Self::decode)
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, FormatError> {
+        let (config, grid) = decode_body(bytes, MapKind::AlphaCut, |c: &AlphaConfig| {
+            c.logodds.resolution.size()
+        })?;
+        let config = config
+            .validate()
+            .map_err(|e| FormatError::Invalid(e.to_string()))?;
+        Ok(AlphaCutMap::from_parts(
+            config,
+            LogOddsMap::from_parts(config.logodds, grid),
+        ))
+    }
+}

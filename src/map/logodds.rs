@@ -1,0 +1,307 @@
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::VoxelMap;
+use super::counts::VoxelCounts;
+use crate::error::{Error, Result, finite};
+use crate::integrate::{
+    DepthFrame, HIT, IntegrationOptions, IntegrationStats, PointCloud, ScanSets, scan_sets,
+};
+use crate::measures::{MeasureConfig, Memberships};
+use crate::storage::{BlockGrid, Resolution, VoxelKey};
+
+/// One log-odds cell: `ln(p / (1 - p))` of being occupied, NaN when never observed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LogOdds(pub f32);
+
+impl Default for LogOdds {
+    fn default() -> Self {
+        Self(f32::NAN)
+    }
+}
+
+impl LogOdds {
+    /// Whether any scan has updated this voxel.
+    #[inline]
+    pub fn is_observed(self) -> bool {
+        !self.0.is_nan()
+    }
+
+    /// The occupancy probability, when observed.
+    #[inline]
+    pub fn probability(self) -> Option<f32> {
+        self.is_observed().then(|| 1.0 / (1.0 + (-self.0).exp()))
+    }
+
+    /// The memberships every map reports: `μO = p`, `μE = 1 - p` when observed, both 0 when
+    /// not.
+    #[inline]
+    pub fn memberships(self) -> Memberships {
+        match self.probability() {
+            Some(p) => Memberships {
+                occupied: p,
+                free: 1.0 - p,
+            },
+            None => Memberships::default(),
+        }
+    }
+}
+
+/// `ln(p / (1 - p))` computed as OctoMap does (in double precision, stored as `float`).
+pub(crate) fn logodds(p: f64) -> f32 {
+    (p / (1.0 - p)).ln() as f32
+}
+
+/// Parameters of the standard log-odds map; the defaults are OctoMap's.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LogOddsConfig {
+    /// Voxel size.
+    pub resolution: Resolution,
+    /// Probability of a hit (0.7).
+    pub prob_hit: f64,
+    /// Probability of a miss (0.4).
+    pub prob_miss: f64,
+    /// Lower clamping probability (0.1192).
+    pub clamp_min: f64,
+    /// Upper clamping probability (0.971).
+    pub clamp_max: f64,
+    /// How measures and classes are computed from `μO = p`, `μE = 1 - p`; with the default
+    /// thresholds a voxel is occupied exactly when `p > 0.5`.
+    pub measures: MeasureConfig,
+}
+
+impl LogOddsConfig {
+    /// OctoMap's defaults at `resolution` metres.
+    pub fn new(resolution: f64) -> Result<Self> {
+        Ok(Self {
+            resolution: Resolution::new(resolution)?,
+            prob_hit: 0.7,
+            prob_miss: 0.4,
+            clamp_min: 0.1192,
+            clamp_max: 0.971,
+            measures: MeasureConfig::default(),
+        })
+    }
+
+    /// Checks every probability lies in `(0, 1)` and `clamp_min < clamp_max`.
+    pub fn validate(self) -> Result<Self> {
+        Resolution::new(self.resolution.size())?;
+        for (name, value) in [
+            ("prob_hit", self.prob_hit),
+            ("prob_miss", self.prob_miss),
+            ("clamp_min", self.clamp_min),
+            ("clamp_max", self.clamp_max),
+        ] {
+            finite(name, value)?;
+            if !(value > 0.0 && value < 1.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    expected: "a probability strictly between 0 and 1",
+                });
+            }
+        }
+        if self.clamp_min >= self.clamp_max {
+            return Err(Error::InvalidParameter {
+                name: "clamp_min",
+                value: self.clamp_min,
+                expected: "a lower clamp below clamp_max",
+            });
+        }
+        self.measures.validate()?;
+        Ok(self)
+    }
+}
+
+/// The standard occupancy map with OctoMap's semantics: per scan, the voxels crossed by rays
+/// (free) and the end-point voxels (hit; a voxel in both is hit) each get one update,
+/// `+logit(prob_hit)` or `+logit(prob_miss)`, clamped to `[logit(clamp_min),
+/// logit(clamp_max)]`. Rays are traversed exactly as OctoMap 1.9 traverses them, so on the same
+/// scan the occupied and free voxel sets equal OctoMap's.
+///
+/// Confidence is ignored: that is what the standard method does. Depth images are inserted as
+/// the point cloud of their `P0` depths, seen from the camera centre.
+#[derive(Clone, Debug)]
+pub struct LogOddsMap {
+    config: LogOddsConfig,
+    hit: f32,
+    miss: f32,
+    min: f32,
+    max: f32,
+    grid: BlockGrid<LogOdds>,
+}
+
+impl LogOddsMap {
+    /// An empty map.
+    pub fn new(config: LogOddsConfig) -> Result<Self> {
+        let config = config.validate()?;
+        Ok(Self::from_parts(config, BlockGrid::new()))
+    }
+
+    pub(crate) fn from_parts(config: LogOddsConfig, mut grid: BlockGrid<LogOdds>) -> Self {
+        let measures = config.measures;
+        let (_, blocks) = grid.blocks_mut();
+        blocks
+            .par_iter_mut()
+            .for_each(|b| b.refresh_summary(|c| measures.classify(c.memberships())));
+        Self {
+            hit: logodds(config.prob_hit),
+            miss: logodds(config.prob_miss),
+            min: logodds(config.clamp_min),
+            max: logodds(config.clamp_max),
+            config,
+            grid,
+        }
+    }
+
+    /// The map's configuration.
+    pub fn config(&self) -> &LogOddsConfig {
+        &self.config
+    }
+
+    /// The underlying block storage (read-only).
+    pub fn grid(&self) -> &BlockGrid<LogOdds> {
+        &self.grid
+    }
+
+    /// The log-odds cell at `key`.
+    pub fn log_odds_at(&self, key: VoxelKey) -> LogOdds {
+        self.grid.cell(key).copied().unwrap_or_default()
+    }
+
+    /// Applies one scan's sets: one clamped update per voxel. Returns the voxels updated.
+    pub fn apply_sets(&mut self, sets: &ScanSets) -> usize {
+        let (hit, miss, min, max) = (self.hit, self.miss, self.min, self.max);
+        let measures = self.config.measures;
+        self.grid.update_from(sets, |block, flags| {
+            let mut updated = 0;
+            for (cell, &flag) in block.cells.iter_mut().zip(flags.cells.iter()) {
+                if flag == 0 {
+                    continue;
+                }
+                let update = if flag & HIT != 0 { hit } else { miss };
+                let current = if cell.is_observed() { cell.0 } else { 0.0 };
+                // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
+                cell.0 = (current + update).clamp(min, max);
+                updated += 1;
+            }
+            block.refresh_summary(|c| measures.classify(c.memberships()));
+            updated
+        })
+    }
+
+    /// Integrates the points that `include` selects as one scan.
+    pub(crate) fn integrate_selected(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+        include: impl Fn(usize) -> bool + Sync,
+    ) -> Result<IntegrationStats> {
+        let (sets, mut stats) = scan_sets(cloud, &self.config.resolution, options, include)?;
+        stats.voxels_updated = self.apply_sets(&sets);
+        Ok(stats)
+    }
+
+    /// Voxel counts per class over the allocated blocks.
+    pub fn counts(&self) -> VoxelCounts {
+        VoxelCounts::of_grid(&self.grid)
+    }
+
+    /// Heap memory held by the map, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.grid.memory_bytes()
+    }
+
+    /// Changes the hit and miss log-odds (for the alpha-cut map's scaled probabilities).
+    pub(crate) fn set_updates(&mut self, hit: f32, miss: f32) {
+        self.hit = hit;
+        self.miss = miss;
+    }
+}
+
+impl VoxelMap for LogOddsMap {
+    fn resolution(&self) -> Resolution {
+        self.config.resolution
+    }
+
+    fn measure_config(&self) -> &MeasureConfig {
+        &self.config.measures
+    }
+
+    fn memberships_at(&self, key: VoxelKey) -> Memberships {
+        self.log_odds_at(key).memberships()
+    }
+
+    fn integrate_cloud(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        self.integrate_selected(cloud, options, |_| true)
+    }
+
+    fn integrate_depth(
+        &mut self,
+        frame: &DepthFrame,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        self.integrate_cloud(&frame.to_cloud()?, options)
+    }
+
+    fn counts(&self) -> VoxelCounts {
+        LogOddsMap::counts(self)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        LogOddsMap::memory_bytes(self)
+    }
+
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
+        Box::new(
+            self.grid
+                .cells()
+                .filter(|(_, c)| c.is_observed())
+                .map(|(k, c)| (k, c.memberships())),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point3;
+
+    #[test]
+    fn octomap_default_log_odds() {
+        assert!((logodds(0.7) - 0.847_298).abs() < 1e-6);
+        assert!((logodds(0.4) + 0.405_465).abs() < 1e-6);
+        assert!((logodds(0.971) - 3.511_031).abs() < 1e-5);
+        assert!((logodds(0.1192) + 2.000_028).abs() < 1e-5);
+    }
+
+    #[test]
+    fn one_scan_marks_hits_and_misses_and_clamps_over_many() {
+        let mut map = LogOddsMap::new(LogOddsConfig::new(0.1).unwrap()).unwrap();
+        let end = Point3::new(1.05, 0.05, 0.05);
+        let cloud = PointCloud::new(Point3::new(0.05, 0.05, 0.05), vec![end]).unwrap();
+        map.integrate_cloud(&cloud, &IntegrationOptions::default())
+            .unwrap();
+        let r = map.resolution();
+        assert_eq!(map.log_odds_at(r.key_of(&end).unwrap()).0, logodds(0.7));
+        let before = r.key_of(&Point3::new(0.55, 0.05, 0.05)).unwrap();
+        assert_eq!(map.log_odds_at(before).0, logodds(0.4));
+        assert!(
+            !map.log_odds_at(r.key_of(&Point3::new(2.0, 0.0, 0.0)).unwrap())
+                .is_observed()
+        );
+        for _ in 0..20 {
+            map.integrate_cloud(&cloud, &IntegrationOptions::default())
+                .unwrap();
+        }
+        assert_eq!(map.log_odds_at(r.key_of(&end).unwrap()).0, logodds(0.971));
+        assert_eq!(map.log_odds_at(before).0, logodds(0.1192));
+        let counts = map.counts();
+        assert_eq!(counts.occupied, 1);
+        assert_eq!(counts.free, 10);
+    }
+}

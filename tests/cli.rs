@@ -1,0 +1,156 @@
+//! The command-line tool, run as a user would.
+
+mod common;
+
+use std::process::Command;
+
+use common::data_dir;
+
+fn fuzzyvox(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
+        .args(args)
+        .output()
+        .expect("running fuzzyvox")
+}
+
+fn json(output: &std::process::Output) -> serde_json::Value {
+    assert!(
+        output.status.success(),
+        "fuzzyvox failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
+}
+
+#[test]
+fn insert_logodds_reports_octomap_counts() {
+    let Some(dir) = data_dir("insert_logodds_reports_octomap_counts") else {
+        return;
+    };
+    let scan = dir.join("octomap-samples/scan.dat");
+    let out = fuzzyvox(&[
+        "insert",
+        "--cloud",
+        scan.to_str().unwrap(),
+        "--res",
+        "0.05",
+        "--model",
+        "logodds",
+        "--json",
+    ]);
+    let report = json(&out);
+    assert_eq!(report["model"], "logodds");
+    assert_eq!(report["points"], 88_206);
+    assert_eq!(report["occupied"], 40_568);
+    assert_eq!(report["free"], 3_855_241);
+    for key in [
+        "resolution",
+        "ambiguous",
+        "unknown",
+        "insert_seconds",
+        "memory_bytes",
+    ] {
+        assert!(report.get(key).is_some(), "missing {key}");
+    }
+}
+
+#[test]
+fn insert_save_and_info_round_trip() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cloud = dir.join("cloud.xyz");
+    let mut text = String::from("# x y z confidence\n");
+    for i in 0..100 {
+        text.push_str(&format!("3.0 {} 0.5 0.9\n", -1.0 + 0.02 * f64::from(i)));
+    }
+    std::fs::write(&cloud, text).unwrap();
+    for model in ["fuzzy", "logodds", "alpha"] {
+        let map = dir.join(format!("{model}.fvx"));
+        let inserted = json(&fuzzyvox(&[
+            "insert",
+            "--cloud",
+            cloud.to_str().unwrap(),
+            "--res",
+            "0.1",
+            "--model",
+            model,
+            "--out",
+            map.to_str().unwrap(),
+            "--json",
+        ]));
+        assert_eq!(inserted["model"], model);
+        assert!(
+            inserted["occupied"].as_u64().unwrap() > 10,
+            "{model}: {inserted}"
+        );
+        let info = json(&fuzzyvox(&["info", map.to_str().unwrap(), "--json"]));
+        assert_eq!(info["model"], model);
+        assert_eq!(info["occupied"], inserted["occupied"]);
+        assert_eq!(info["free"], inserted["free"]);
+        let text = fuzzyvox(&["info", map.to_str().unwrap()]);
+        assert!(text.status.success());
+        assert!(String::from_utf8_lossy(&text.stdout).contains("occupied"));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn errors_are_clear_and_exit_non_zero() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let plain = dir.join("plain.xyz");
+    std::fs::write(&plain, "1 2 3\n4 5 6\n").unwrap();
+    let bad = dir.join("bad.xyz");
+    std::fs::write(&bad, "1 2 3\n4 five 6\n").unwrap();
+    let not_a_map = dir.join("not-a-map.fvx");
+    std::fs::write(&not_a_map, "hello").unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "insert",
+                "--cloud",
+                plain.to_str().unwrap(),
+                "--res",
+                "0.1",
+                "--model",
+                "alpha",
+            ],
+            "needs a confidence per point",
+        ),
+        (
+            vec!["insert", "--cloud", bad.to_str().unwrap(), "--res", "0.1"],
+            ":2:",
+        ),
+        (
+            vec!["insert", "--cloud", plain.to_str().unwrap(), "--res", "-1"],
+            "resolution",
+        ),
+        (
+            vec![
+                "insert",
+                "--cloud",
+                plain.to_str().unwrap(),
+                "--res",
+                "0.1",
+                "--op",
+                "dombi",
+            ],
+            "dombi",
+        ),
+        (
+            vec!["insert", "--cloud", "/nonexistent.xyz", "--res", "0.1"],
+            "nonexistent",
+        ),
+        (
+            vec!["info", not_a_map.to_str().unwrap()],
+            "not a fuzzyvox map",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = fuzzyvox(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
