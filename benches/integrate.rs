@@ -1,5 +1,5 @@
-//! Integration speed on real data: fuzzy ray integration of OctoMap's `scan.dat` and projective
-//! integration of one 640×480 7-Scenes depth frame.
+//! Integration speed on real data: fuzzy and log-odds ray integration of OctoMap's `scan.dat`,
+//! and projective integration of one 640×480 7-Scenes depth frame.
 //!
 //! Needs `FUZZYVOX_DATA` (the shared data folder); without it the benchmarks say so and skip.
 //! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench integrate`.
@@ -11,7 +11,9 @@ use fuzzyvox::io::read_text_cloud;
 use fuzzyvox::io::rgbd::{
     kinect_interval_image, read_depth_png_mm, read_intrinsics_txt, read_pose_txt,
 };
-use fuzzyvox::{DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions, VoxelMap};
+use fuzzyvox::{
+    DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions, LogOddsConfig, LogOddsMap, VoxelMap,
+};
 use nalgebra::Point3;
 
 fn data_dir() -> Option<PathBuf> {
@@ -32,6 +34,25 @@ fn ray_integration(c: &mut Criterion) {
         group.bench_function(format!("{resolution}m"), |b| {
             b.iter(|| {
                 let mut map = FuzzyMap::new(FuzzyConfig::new(resolution).unwrap()).unwrap();
+                map.integrate_cloud(&cloud, &IntegrationOptions::default())
+                    .unwrap();
+                map
+            })
+        });
+    }
+    group.finish();
+}
+
+fn log_odds_integration(c: &mut Criterion) {
+    let Some(dir) = data_dir() else { return };
+    let cloud = read_text_cloud(&dir.join("octomap-samples/scan.dat"), Point3::origin())
+        .expect("reading scan.dat");
+    let mut group = c.benchmark_group("logodds_ray_scan_dat");
+    group.sample_size(10);
+    for resolution in [0.1, 0.05] {
+        group.bench_function(format!("{resolution}m"), |b| {
+            b.iter(|| {
+                let mut map = LogOddsMap::new(LogOddsConfig::new(resolution).unwrap()).unwrap();
                 map.integrate_cloud(&cloud, &IntegrationOptions::default())
                     .unwrap();
                 map
@@ -67,5 +88,10 @@ fn projective_integration(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_integration, projective_integration);
+criterion_group!(
+    benches,
+    ray_integration,
+    log_odds_integration,
+    projective_integration
+);
 criterion_main!(benches);

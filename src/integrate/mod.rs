@@ -26,4 +26,4 @@ pub use frustum::depth_evidence;
 pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;
 pub use raywalk::walk_ray;
-pub use scan_sets::{HIT, PASSED, ScanSets, scan_sets};
+pub use scan_sets::{BlockFlags, ScanSets, scan_sets};

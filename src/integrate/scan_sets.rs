@@ -1,19 +1,118 @@
+use nalgebra::Point3;
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::cloud::PointCloud;
 use super::evidence::{IntegrationOptions, IntegrationStats};
 use super::octomap_walk::walk_ray_octomap;
 use crate::error::{Error, Result};
-use crate::storage::{AccessorMut, BlockGrid, Resolution};
+use crate::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
 
-/// Flag: a ray of the scan passed through the voxel.
-pub const PASSED: u8 = 1;
-/// Flag: an end point of the scan lies in the voxel.
-pub const HIT: u8 = 2;
+/// One block of a scan's sets as bitsets: bit `i % 64` of word `i / 64` is cell `i`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BlockFlags {
+    /// Cells that a ray passed through.
+    pub passed: [u64; BLOCK_CELLS / 64],
+    /// Cells that hold an end point.
+    pub hit: [u64; BLOCK_CELLS / 64],
+}
+
+impl BlockFlags {
+    /// Whether a ray passed through cell `i`, and whether it holds an end point.
+    #[inline]
+    pub fn get(&self, i: usize) -> (bool, bool) {
+        let (word, bit) = (i / 64, 1u64 << (i % 64));
+        (self.passed[word] & bit != 0, self.hit[word] & bit != 0)
+    }
+}
 
 /// One scan in the standard method's terms: per voxel, whether a ray passed through it and
-/// whether an end point lies in it. A voxel with both counts as hit.
-pub type ScanSets = BlockGrid<u8>;
+/// whether an end point lies in it (a voxel with both counts as hit). Two bits per voxel keep
+/// a whole scan's sets small enough to stay in cache while rays are walked.
+#[derive(Clone, Debug, Default)]
+pub struct ScanSets {
+    index: FxHashMap<BlockKey, usize>,
+    keys: Vec<BlockKey>,
+    blocks: Vec<BlockFlags>,
+}
+
+impl ScanSets {
+    /// No voxel marked.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Blocks with any voxel marked, with their keys.
+    pub fn blocks(&self) -> impl ExactSizeIterator<Item = (BlockKey, &BlockFlags)> {
+        self.keys.iter().copied().zip(self.blocks.iter())
+    }
+
+    /// Whether a ray passed through `key`, and whether it holds an end point.
+    pub fn flags(&self, key: VoxelKey) -> (bool, bool) {
+        self.index
+            .get(&key.block())
+            .map_or((false, false), |&i| self.blocks[i].get(key.cell_index()))
+    }
+
+    #[inline]
+    fn position(&mut self, key: BlockKey) -> usize {
+        *self.index.entry(key).or_insert_with(|| {
+            self.keys.push(key);
+            self.blocks.push(BlockFlags::default());
+            self.blocks.len() - 1
+        })
+    }
+
+    /// Unites two partial scans (bitwise or: exact, so the split does not matter).
+    fn union(mut self, other: ScanSets) -> ScanSets {
+        if self.blocks.len() < other.blocks.len() {
+            return other.union(self);
+        }
+        for (key, flags) in other.blocks() {
+            let position = self.position(key);
+            let target = &mut self.blocks[position];
+            for w in 0..BLOCK_CELLS / 64 {
+                target.passed[w] |= flags.passed[w];
+                target.hit[w] |= flags.hit[w];
+            }
+        }
+        self
+    }
+}
+
+/// Marks voxels in a [`ScanSets`], caching the last block.
+struct Marker<'a> {
+    sets: &'a mut ScanSets,
+    last: Option<(BlockKey, usize)>,
+}
+
+impl Marker<'_> {
+    #[inline]
+    fn block(&mut self, key: VoxelKey) -> &mut BlockFlags {
+        let block_key = key.block();
+        let position = match self.last {
+            Some((cached, position)) if cached == block_key => position,
+            _ => {
+                let position = self.sets.position(block_key);
+                self.last = Some((block_key, position));
+                position
+            }
+        };
+        &mut self.sets.blocks[position]
+    }
+
+    #[inline]
+    fn pass(&mut self, key: VoxelKey) {
+        let i = key.cell_index();
+        self.block(key).passed[i / 64] |= 1 << (i % 64);
+    }
+
+    #[inline]
+    fn hit(&mut self, key: VoxelKey) {
+        let i = key.cell_index();
+        self.block(key).hit[i / 64] |= 1 << (i % 64);
+    }
+}
 
 /// Points per unit of parallel work.
 const CHUNK: usize = 1024;
@@ -33,14 +132,10 @@ pub fn scan_sets(
     let options = options.validate()?;
     let origin = cloud.origin();
     resolution.key_of(&origin)?;
-    if let Some(p) = cloud
-        .points()
-        .par_iter()
-        .filter(|p| p.iter().all(|v| v.is_finite()))
-        .find_first(|p| {
-            resolution.try_key_of(p).is_none() || p.iter().any(|v| !(*v as f32).is_finite())
-        })
-    {
+    let finite = |p: &Point3<f64>| p.iter().all(|v| v.is_finite());
+    if let Some(p) = cloud.points().par_iter().filter(|p| finite(p)).find_first(|p| {
+        resolution.try_key_of(p).is_none() || p.iter().any(|v| !(*v as f32).is_finite())
+    }) {
         return Err(Error::OutOfKeyRange {
             x: p.x,
             y: p.y,
@@ -48,17 +143,21 @@ pub fn scan_sets(
             resolution: resolution.size(),
         });
     }
-    let single = |p: &nalgebra::Point3<f64>| [p.x as f32, p.y as f32, p.z as f32];
+    let single = |p: &Point3<f64>| [p.x as f32, p.y as f32, p.z as f32];
     let origin32 = single(&origin);
     let max_range = options.max_range;
+    // Each piece of work marks its own partial sets; `or` unites them exactly.
     let sets = cloud
         .points()
         .par_chunks(CHUNK)
         .enumerate()
         .fold(ScanSets::new, |mut sets, (chunk_index, chunk)| {
-            let mut acc = AccessorMut::new(&mut sets);
+            let mut marker = Marker {
+                sets: &mut sets,
+                last: None,
+            };
             for (offset, point) in chunk.iter().enumerate() {
-                if !point.iter().all(|v| v.is_finite()) || !include(chunk_index * CHUNK + offset) {
+                if !finite(point) || !include(chunk_index * CHUNK + offset) {
                     continue;
                 }
                 let p = single(point);
@@ -68,79 +167,34 @@ pub fn scan_sets(
                 match max_range {
                     Some(max) if range > max => {
                         // OctoMap: origin + normalized direction × (float) max_range.
-                        let length = range as f32;
-                        let m = max as f32;
+                        let (length, m) = (range as f32, max as f32);
                         let end = [
                             origin32[0] + delta[0] / length * m,
                             origin32[1] + delta[1] / length * m,
                             origin32[2] + delta[2] / length * m,
                         ];
-                        walk_ray_octomap(resolution, origin32, end, |key| {
-                            *acc.get_or_insert(key) |= PASSED;
-                        });
+                        walk_ray_octomap(resolution, origin32, end, |key| marker.pass(key));
                     }
                     _ => {
-                        walk_ray_octomap(resolution, origin32, p, |key| {
-                            *acc.get_or_insert(key) |= PASSED;
-                        });
-                        let end = nalgebra::Point3::new(
-                            f64::from(p[0]),
-                            f64::from(p[1]),
-                            f64::from(p[2]),
-                        );
+                        walk_ray_octomap(resolution, origin32, p, |key| marker.pass(key));
+                        let end = Point3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
                         if let Some(key) = resolution.try_key_of(&end) {
-                            *acc.get_or_insert(key) |= HIT;
+                            marker.hit(key);
                         }
                     }
                 }
             }
             sets
         })
-        .reduce(ScanSets::new, merge_or);
-    let integrated = cloud
-        .points()
-        .iter()
-        .enumerate()
-        .filter(|(i, p)| p.iter().all(|v| v.is_finite()) && include(*i))
-        .count();
-    let clipped = match max_range {
-        Some(max) => cloud
-            .points()
-            .iter()
-            .enumerate()
-            .filter(|(i, p)| include(*i) && (**p - origin).norm() > max)
-            .count(),
-        None => 0,
-    };
-    let finite = cloud
-        .points()
-        .iter()
-        .filter(|p| p.iter().all(|v| v.is_finite()))
-        .count();
-    let stats = IntegrationStats {
-        integrated,
-        skipped: cloud.len() - finite,
-        clipped,
-        voxels_updated: 0,
-    };
-    Ok((sets, stats))
-}
-
-/// Unites two partial scans (bitwise or: exact, so the split does not matter).
-fn merge_or(mut a: ScanSets, b: ScanSets) -> ScanSets {
-    if a.block_count() < b.block_count() {
-        return merge_or(b, a);
-    }
-    for (key, block) in b.blocks() {
-        let position = a.ensure_block(key);
-        for (t, s) in a
-            .block_at_mut(position)
-            .cells
-            .iter_mut()
-            .zip(block.cells.iter())
-        {
-            *t |= *s;
+        .reduce(ScanSets::new, ScanSets::union);
+    let mut stats = IntegrationStats::default();
+    for (i, p) in cloud.points().iter().enumerate() {
+        if !finite(p) {
+            stats.skipped += 1;
+        } else if include(i) {
+            stats.integrated += 1;
+            stats.clipped += usize::from(max_range.is_some_and(|max| (p - origin).norm() > max));
         }
     }
-    a
+    Ok((sets, stats))
 }

@@ -5,7 +5,7 @@ use super::VoxelMap;
 use super::counts::VoxelCounts;
 use crate::error::{Error, Result, finite};
 use crate::integrate::{
-    DepthFrame, HIT, IntegrationOptions, IntegrationStats, PointCloud, ScanSets, scan_sets,
+    DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanSets, scan_sets,
 };
 use crate::measures::{MeasureConfig, Memberships};
 use crate::storage::{BlockGrid, Resolution, VoxelKey};
@@ -171,15 +171,16 @@ impl LogOddsMap {
 
     /// Applies one scan's sets: one clamped update per voxel. Returns the voxels updated.
     pub fn apply_sets(&mut self, sets: &ScanSets) -> usize {
-        let (hit, miss, min, max) = (self.hit, self.miss, self.min, self.max);
+        let (hit_update, miss, min, max) = (self.hit, self.miss, self.min, self.max);
         let measures = self.config.measures;
-        self.grid.update_from(sets, |block, flags| {
+        self.grid.update_blocks(sets.blocks().collect(), |block, flags| {
             let mut updated = 0;
-            for (cell, &flag) in block.cells.iter_mut().zip(flags.cells.iter()) {
-                if flag == 0 {
+            for (i, cell) in block.cells.iter_mut().enumerate() {
+                let (passed, hit) = flags.get(i);
+                if !(passed || hit) {
                     continue;
                 }
-                let update = if flag & HIT != 0 { hit } else { miss };
+                let update = if hit { hit_update } else { miss };
                 let current = if cell.is_observed() { cell.0 } else { 0.0 };
                 // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
                 cell.0 = (current + update).clamp(min, max);

@@ -216,8 +216,7 @@ impl<C: Copy + Default> BlockGrid<C> {
 
     /// Updates every block that has a counterpart in `source` with `update(block, source_block)`,
     /// in parallel, each block by one thread (so the result does not depend on the thread
-    /// count). Missing blocks are allocated first, in key order, so the storage order does not
-    /// depend on how `source` was built. Returns the sum of what `update` returns.
+    /// count). Missing blocks are allocated first. Returns the sum of what `update` returns.
     pub fn update_from<S: Copy + Default + Sync>(
         &mut self,
         source: &BlockGrid<S>,
@@ -226,9 +225,24 @@ impl<C: Copy + Default> BlockGrid<C> {
     where
         C: Send + Sync,
     {
-        let missing: Vec<BlockKey> = source
-            .sorted_block_keys()
-            .into_iter()
+        self.update_blocks(source.blocks().collect(), update)
+    }
+
+    /// Like [`BlockGrid::update_from`] for any per-block payload: `sources` pairs block keys
+    /// with what each block is updated from. Missing blocks are allocated in key order, so
+    /// the storage order does not depend on the order of `sources`.
+    pub fn update_blocks<S: Sync>(
+        &mut self,
+        mut sources: Vec<(BlockKey, &S)>,
+        update: impl Fn(&mut Block<C>, &S) -> usize + Sync,
+    ) -> usize
+    where
+        C: Send + Sync,
+    {
+        sources.sort_unstable_by_key(|(key, _)| *key);
+        let missing: Vec<BlockKey> = sources
+            .iter()
+            .map(|(key, _)| *key)
             .filter(|&key| self.position(key).is_none())
             .collect();
         // The (page-faulting) allocations run in parallel; the insertions are cheap.
@@ -236,15 +250,15 @@ impl<C: Copy + Default> BlockGrid<C> {
         for (key, block) in missing.into_iter().zip(fresh) {
             self.insert_block(key, block);
         }
-        let mut sources: Vec<Option<&Block<S>>> = vec![None; self.blocks.len()];
-        for (key, block) in source.blocks() {
+        let mut by_position: Vec<Option<&S>> = vec![None; self.blocks.len()];
+        for (key, source) in sources {
             if let Some(position) = self.position(key) {
-                sources[position] = Some(block);
+                by_position[position] = Some(source);
             }
         }
         self.blocks
             .par_iter_mut()
-            .zip(sources.par_iter())
+            .zip(by_position.par_iter())
             .map(|(block, source)| source.map_or(0, |s| update(block, s)))
             .sum()
     }
