@@ -182,8 +182,8 @@ fn octomap_tool(test: &str) -> Option<PathBuf> {
         .is_ok_and(|o| o.status.success());
     if !(compiler && header.exists()) {
         let why = format!(
-            "{test}: OctoMap is not installed (g++: {compiler}, {}: {}); \
-             apt-get install liboctomap-dev",
+            "{test}: OctoMap is not installed (g++ found: {compiler}, {} found: {}) \
+             (apt-get install liboctomap-dev)",
             header.display(),
             header.exists()
         );

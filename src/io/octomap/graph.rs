@@ -79,10 +79,13 @@ pub fn decode_scan_graph(bytes: &[u8]) -> Result<Vec<ScanNode>, FormatError> {
         });
     }
     let edge_count = count(&mut c, "edge count", EDGE_BYTES)?;
+    // Sorted ids: edge checks stay O(log n) on large graphs.
+    let mut ids: Vec<u32> = nodes.iter().map(|n| n.id).collect();
+    ids.sort_unstable();
     for index in 0..edge_count {
         for end in ["first", "second"] {
             let id = c.u32("edge node id")?;
-            if !nodes.iter().any(|n| n.id == id) {
+            if ids.binary_search(&id).is_err() {
                 return Err(FormatError::Invalid(format!(
                     "edge {index}: its {end} node id {id} names no node"
                 )));
