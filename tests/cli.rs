@@ -154,3 +154,40 @@ fn errors_are_clear_and_exit_non_zero() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn insert_reads_octomap_scan_graphs_and_alpha_refuses_them() {
+    let Some(dir) = data_dir("insert_reads_octomap_scan_graphs_and_alpha_refuses_them") else {
+        return;
+    };
+    let graph = dir.join("octomap-samples/spherical_scan.graph");
+    let report = json(&fuzzyvox(&[
+        "insert",
+        "--cloud",
+        graph.to_str().unwrap(),
+        "--res",
+        "0.2",
+        "--model",
+        "logodds",
+        "--json",
+    ]));
+    assert_eq!(report["scans"], 1);
+    assert_eq!(report["points"], 10_201);
+    // OctoMap 1.9.7 (ScanGraph::readBinary, then OcTree::insertPointCloud of each node at
+    // 0.2 m) holds 425 occupied and 2,262 free voxels for this graph.
+    assert_eq!(
+        (report["occupied"].as_u64(), report["free"].as_u64()),
+        (Some(425), Some(2262))
+    );
+    let alpha = fuzzyvox(&[
+        "insert",
+        "--cloud",
+        graph.to_str().unwrap(),
+        "--res",
+        "0.2",
+        "--model",
+        "alpha",
+    ]);
+    assert!(!alpha.status.success());
+    assert!(String::from_utf8_lossy(&alpha.stderr).contains("needs a confidence per point"));
+}

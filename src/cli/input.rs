@@ -4,12 +4,27 @@ use std::path::Path;
 
 use anyhow::Context;
 use fuzzyvox::PointCloud;
+use fuzzyvox::io::octomap::{read_scan_graph, read_scan_log};
 use fuzzyvox::io::read_text_cloud;
 use nalgebra::Point3;
 
-/// The scans in `path`: one for a text cloud (`x y z [confidence]`, seen from `origin`).
+/// The scans in `path`: every node of an OctoMap scan graph (`.graph`) or scan log (`.log`),
+/// each from its own pose, or one text cloud (`x y z [confidence]`) seen from `origin`.
 pub fn read_scans(path: &Path, origin: Point3<f64>) -> anyhow::Result<Vec<PointCloud>> {
-    let cloud = read_text_cloud(path, origin)
-        .with_context(|| format!("reading the cloud {}", path.display()))?;
-    Ok(vec![cloud])
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let reading = || format!("reading {}", path.display());
+    let nodes = match extension.as_deref() {
+        Some("graph") => read_scan_graph(path).with_context(reading)?,
+        Some("log") => read_scan_log(path).with_context(reading)?,
+        _ => return Ok(vec![read_text_cloud(path, origin).with_context(reading)?]),
+    };
+    nodes
+        .iter()
+        .map(|node| {
+            node.to_cloud()
+                .with_context(|| format!("scan node {} of {}", node.id, path.display()))
+        })
+        .collect()
 }

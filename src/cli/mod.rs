@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Each command lives in its own file and only calls the
 //! library.
 
+mod export;
 mod info;
 mod input;
 mod insert;
@@ -21,6 +22,7 @@ struct Cli {
 enum Command {
     Insert(insert::InsertArgs),
     Info(info::InfoArgs),
+    Export(export::ExportArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -29,6 +31,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
+        Command::Export(args) => export::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

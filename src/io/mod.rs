@@ -1,10 +1,12 @@
-//! Reading and writing files: native map files and text point clouds.
+//! Reading and writing files: native map files, text point clouds, RGB-D frames and OctoMap's
+//! formats.
 
 mod atomic;
 mod cloud_text;
 mod fuzzy_file;
 mod logodds_file;
 mod mapfile;
+pub mod octomap;
 pub mod rgbd;
 mod stored_blocks;
 
