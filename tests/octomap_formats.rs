@@ -194,7 +194,9 @@ fn octomap_tool(test: &str) -> Option<PathBuf> {
         eprintln!("SKIPPED {why}");
         return None;
     }
-    let tool = Path::new(env!("CARGO_TARGET_TMPDIR")).join("octomap_tree_info");
+    // One binary per test: tests run in parallel, and running a binary while another test
+    // rewrites it fails with "text file busy".
+    let tool = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("octomap_tree_info-{test}"));
     let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/octomap_tree_info.cpp");
     let output = Command::new("g++")
         .arg("-O2")

@@ -105,19 +105,25 @@ impl FuzzyMap {
     ) -> usize {
         let operator = self.config.operator;
         let measures = self.config.measures;
+        let classify = |m: Memberships| measures.classify(m);
         self.grid.update_from(source, |block, source| {
             let mut updated = 0;
             for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
                 let (o, e) = evidence_of(s);
+                if o <= 0.0 && e <= 0.0 {
+                    continue;
+                }
+                let before = *cell;
                 if o > 0.0 {
                     cell.occupied = operator.apply(cell.occupied, o);
                 }
                 if e > 0.0 {
                     cell.free = operator.apply(cell.free, e);
                 }
-                updated += usize::from(o > 0.0 || e > 0.0);
+                // Keep the block's class counts current without reclassifying every cell.
+                block.summary.moved(classify(before), classify(*cell));
+                updated += 1;
             }
-            block.refresh_summary(|m| measures.classify(*m));
             updated
         })
     }

@@ -173,21 +173,26 @@ impl LogOddsMap {
     pub fn apply_sets(&mut self, sets: &ScanSets) -> usize {
         let (hit_update, miss, min, max) = (self.hit, self.miss, self.min, self.max);
         let measures = self.config.measures;
+        let classify = |c: LogOdds| measures.classify(c.memberships());
         self.grid
             .update_blocks(sets.blocks().collect(), |block, flags| {
                 let mut updated = 0;
-                for (i, cell) in block.cells.iter_mut().enumerate() {
-                    let (passed, hit) = flags.get(i);
-                    if !(passed || hit) {
-                        continue;
+                for word in 0..flags.passed.len() {
+                    let mut marked = flags.passed[word] | flags.hit[word];
+                    while marked != 0 {
+                        let bit = marked.trailing_zeros() as usize;
+                        marked &= marked - 1;
+                        let hit = flags.hit[word] & (1 << bit) != 0;
+                        let cell = &mut block.cells[word * 64 + bit];
+                        let before = *cell;
+                        let current = if before.is_observed() { before.0 } else { 0.0 };
+                        // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
+                        cell.0 = (current + if hit { hit_update } else { miss }).clamp(min, max);
+                        // Keep the block's class counts current without reclassifying every cell.
+                        block.summary.moved(classify(before), classify(*cell));
+                        updated += 1;
                     }
-                    let update = if hit { hit_update } else { miss };
-                    let current = if cell.is_observed() { cell.0 } else { 0.0 };
-                    // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
-                    cell.0 = (current + update).clamp(min, max);
-                    updated += 1;
                 }
-                block.refresh_summary(|c| measures.classify(c.memberships()));
                 updated
             })
     }

@@ -34,6 +34,15 @@ impl ClassCounts {
         Self(counts)
     }
 
+    /// Records that one cell changed class from `from` to `to`.
+    #[inline]
+    pub fn moved(&mut self, from: VoxelClass, to: VoxelClass) {
+        if from != to {
+            self.0[from.index()] = self.0[from.index()].saturating_sub(1);
+            self.0[to.index()] += 1;
+        }
+    }
+
     /// Cells of class `class`.
     #[inline]
     pub fn get(&self, class: VoxelClass) -> usize {
@@ -53,10 +62,14 @@ pub struct Block<C> {
 }
 
 impl<C: Copy + Default> Default for Block<C> {
+    /// A block of default cells, all counted as unknown (the class of a default cell in every
+    /// map).
     fn default() -> Self {
+        let mut summary = ClassCounts::default();
+        summary.0[VoxelClass::Unknown.index()] = BLOCK_CELLS as u16;
         Self {
             cells: [C::default(); BLOCK_CELLS],
-            summary: ClassCounts::default(),
+            summary,
         }
     }
 }
