@@ -39,6 +39,7 @@ pub mod io;
 pub mod map;
 pub mod measures;
 pub mod ops;
+pub mod plan;
 pub mod storage;
 
 pub use error::{Error, FormatError, Result};

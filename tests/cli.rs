@@ -191,3 +191,61 @@ fn insert_reads_octomap_scan_graphs_and_alpha_refuses_them() {
     assert!(!alpha.status.success());
     assert!(String::from_utf8_lossy(&alpha.stderr).contains("needs a confidence per point"));
 }
+
+#[test]
+fn plan_through_a_saved_map() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 6 × 4 m wall 3 m ahead of the sensor.
+    let cloud = dir.join("wall.xyz");
+    let mut text = String::new();
+    for i in 0..=120 {
+        for j in 0..=80 {
+            let (y, z) = (-3.0 + 0.05 * f64::from(i), -1.5 + 0.05 * f64::from(j));
+            text.push_str(&format!("3.0 {y} {z}\n"));
+        }
+    }
+    std::fs::write(&cloud, text).unwrap();
+    let map = dir.join("wall.fvx");
+    json(&fuzzyvox(&[
+        "insert",
+        "--cloud",
+        cloud.to_str().unwrap(),
+        "--res",
+        "0.1",
+        "--origin",
+        "0,0,0.5",
+        "--out",
+        map.to_str().unwrap(),
+        "--json",
+    ]));
+    let plan = json(&fuzzyvox(&[
+        "plan",
+        "--map",
+        map.to_str().unwrap(),
+        "--from",
+        "1.5,0,0.5",
+        "--to",
+        "2.5,0.3,0.6",
+        "--radius",
+        "0.1",
+        "--json",
+    ]));
+    let waypoints = plan["waypoints"].as_array().unwrap();
+    assert!(waypoints.len() >= 2);
+    assert!(plan["length_m"].as_f64().unwrap() >= 1.0);
+    assert!(plan["min_safety"].as_f64().unwrap() >= 0.2);
+    // Behind the wall is unknown: no path, a clear error and a non-zero exit.
+    let behind = fuzzyvox(&[
+        "plan",
+        "--map",
+        map.to_str().unwrap(),
+        "--from",
+        "1.5,0,0.5",
+        "--to",
+        "4,0,0.5",
+    ]);
+    assert!(!behind.status.success());
+    assert!(String::from_utf8_lossy(&behind.stderr).contains("goal is not safe"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

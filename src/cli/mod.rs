@@ -5,6 +5,7 @@ mod export;
 mod info;
 mod input;
 mod insert;
+mod plan;
 
 use std::process::ExitCode;
 
@@ -23,6 +24,7 @@ enum Command {
     Insert(insert::InsertArgs),
     Info(info::InfoArgs),
     Export(export::ExportArgs),
+    Plan(plan::PlanArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -32,6 +34,7 @@ pub fn run() -> ExitCode {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
         Command::Export(args) => export::run(args),
+        Command::Plan(args) => plan::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,7 +21,7 @@ use crate::storage::{Resolution, VoxelKey};
 
 /// What every map offers: integration of the same observations, and the same measures per
 /// voxel, so that experiments can feed identical data to each map and compare them fairly.
-pub trait VoxelMap {
+pub trait VoxelMap: Send + Sync {
     /// The voxel size.
     fn resolution(&self) -> Resolution;
 

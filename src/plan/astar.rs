@@ -1,0 +1,253 @@
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use nalgebra::Point3;
+use ordered_float::OrderedFloat;
+use petgraph::visit::{EdgeRef, IntoEdges};
+use serde::Serialize;
+
+use super::config::PlannerConfig;
+use super::cost_field::{CostField, PlanningRegion};
+use super::graph::VoxelGraph;
+use crate::error::Error;
+use crate::integrate::walk_ray;
+use crate::map::VoxelMap;
+use crate::storage::VoxelKey;
+
+/// A planned path.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Path {
+    /// Waypoints in world coordinates (voxel centres), start first, after line-of-sight
+    /// shortcutting.
+    pub waypoints: Vec<Point3<f64>>,
+    /// Length of the waypoint polyline in metres.
+    pub length: f64,
+    /// Cost of the A* path before shortcutting (metres weighted by the cost field).
+    pub cost: f64,
+    /// Lowest safety of any voxel the final path passes through.
+    pub min_safety: f32,
+    /// Lowest clearance (metres, voxel centre to the nearest blocked voxel centre) of any voxel
+    /// the final path passes through.
+    pub min_clearance: f32,
+    /// Nodes A* expanded.
+    pub expanded: usize,
+}
+
+/// Why no path was found.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    /// The start or goal lies outside the planning region.
+    #[error("the {0} lies outside the planning region")]
+    OutOfRegion(&'static str),
+    /// The start voxel cannot be entered (blocked, unsafe, unknown, or too close to an obstacle).
+    #[error("the start is not safe: {0}")]
+    StartUnsafe(String),
+    /// The goal voxel cannot be entered.
+    #[error("the goal is not safe: {0}")]
+    GoalUnsafe(String),
+    /// Start and goal are not connected through traversable voxels.
+    #[error(
+        "the goal is not connected to the start through safe space ({expanded} voxels searched)"
+    )]
+    Disconnected {
+        /// Nodes expanded before the search ran out.
+        expanded: usize,
+    },
+    /// The map or the configuration rejected the request.
+    #[error(transparent)]
+    Map(#[from] Error),
+}
+
+/// Plans from `from` to `to` in any map: builds the cost field of the box around both points
+/// grown by a margin (the vehicle radius plus the preferred clearance plus 2 m), then runs
+/// [`plan_in_field`].
+pub fn plan_path(
+    map: &dyn VoxelMap,
+    from: &Point3<f64>,
+    to: &Point3<f64>,
+    config: &PlannerConfig,
+) -> Result<Path, PlanError> {
+    let config = config.validate()?;
+    let resolution = map.resolution();
+    let start = resolution.key_of(from)?;
+    let goal = resolution.key_of(to)?;
+    let margin = config.vehicle_radius + config.preferred_clearance + 2.0;
+    let region = PlanningRegion::around(&resolution, from, to, margin)?;
+    let field = CostField::build(map, region, config)?;
+    plan_in_field(&field, start, goal)
+}
+
+/// A* from `start` to `goal` over the field's 26-connected graph (through petgraph's
+/// [`IntoEdges`]), with dense per-voxel arrays and the octile distance times the field's lowest
+/// cost rate as a consistent heuristic, then line-of-sight shortcutting checked against the
+/// same field. Ties are broken by node index, so the result is deterministic.
+pub fn plan_in_field(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+) -> Result<Path, PlanError> {
+    let region = field.region();
+    let start_index = region
+        .index_of(start)
+        .ok_or(PlanError::OutOfRegion("start"))?;
+    let goal_index = region
+        .index_of(goal)
+        .ok_or(PlanError::OutOfRegion("goal"))?;
+    if !field.is_traversable(start_index) {
+        return Err(PlanError::StartUnsafe(why_not(field, start_index)));
+    }
+    if !field.is_traversable(goal_index) {
+        return Err(PlanError::GoalUnsafe(why_not(field, goal_index)));
+    }
+    // Metres of the shortest 26-connected route times the lowest rate: never more than the
+    // true remaining cost, and consistent because every step costs at least its length times
+    // that rate.
+    let size = field.resolution().size() as f32 * field.min_rate();
+    let heuristic = |key: VoxelKey| {
+        let mut d = [
+            (key.x - goal.x).unsigned_abs() as f32,
+            (key.y - goal.y).unsigned_abs() as f32,
+            (key.z - goal.z).unsigned_abs() as f32,
+        ];
+        d.sort_unstable_by(|a, b| b.total_cmp(a));
+        let sqrt3 = 1.732_050_8_f32;
+        size * ((d[0] - d[1]) + std::f32::consts::SQRT_2 * (d[1] - d[2]) + sqrt3 * d[2])
+    };
+    let graph = VoxelGraph::new(field);
+    let n = region.len();
+    let mut best = vec![f32::INFINITY; n];
+    let mut parent = vec![u32::MAX; n];
+    let mut closed = vec![false; n];
+    let mut open = BinaryHeap::new();
+    best[start_index] = 0.0;
+    open.push(Reverse((
+        OrderedFloat(heuristic(start)),
+        start_index as u32,
+    )));
+    let mut expanded = 0;
+    while let Some(Reverse((_, node))) = open.pop() {
+        let node_index = node as usize;
+        if closed[node_index] {
+            continue;
+        }
+        closed[node_index] = true;
+        expanded += 1;
+        if node_index == goal_index {
+            break;
+        }
+        let g = best[node_index];
+        for edge in graph.edges(node) {
+            let target = edge.target() as usize;
+            if closed[target] {
+                continue;
+            }
+            let candidate = g + *edge.weight();
+            if candidate < best[target] {
+                best[target] = candidate;
+                parent[target] = node;
+                let f = candidate + heuristic(region.key_at(target));
+                open.push(Reverse((OrderedFloat(f), target as u32)));
+            }
+        }
+    }
+    if !closed[goal_index] {
+        return Err(PlanError::Disconnected { expanded });
+    }
+    let mut voxels = vec![goal];
+    let mut node = goal_index;
+    while node != start_index {
+        node = parent[node] as usize;
+        voxels.push(region.key_at(node));
+    }
+    voxels.reverse();
+    let corners = shortcut(field, &voxels);
+    let resolution = field.resolution();
+    let waypoints: Vec<Point3<f64>> = corners.iter().map(|k| resolution.center(*k)).collect();
+    let length = waypoints.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let (mut min_safety, mut min_clearance) = (f32::INFINITY, f32::INFINITY);
+    for pair in corners.windows(2) {
+        segment_voxels(field, pair[0], pair[1], |index| {
+            min_safety = min_safety.min(field.safety(index));
+            min_clearance = min_clearance.min(field.clearance(index));
+            true
+        });
+    }
+    if corners.len() == 1 {
+        min_safety = field.safety(start_index);
+        min_clearance = field.clearance(start_index);
+    }
+    Ok(Path {
+        waypoints,
+        length,
+        cost: f64::from(best[goal_index]),
+        min_safety,
+        min_clearance,
+        expanded,
+    })
+}
+
+/// Why a voxel cannot be entered, in words.
+fn why_not(field: &CostField, index: usize) -> String {
+    let required = field.config().vehicle_radius + 3f64.sqrt() * field.resolution().size();
+    let clearance = f64::from(field.clearance(index));
+    if clearance == 0.0 {
+        format!(
+            "the voxel is blocked (occupied, ambiguous, unknown or safety {:.2} below {:.2})",
+            field.safety(index),
+            field.config().safety_threshold
+        )
+    } else {
+        format!(
+            "the nearest blocked voxel is {clearance:.2} m away; {required:.2} m is needed for a vehicle of radius {:.2} m",
+            field.config().vehicle_radius
+        )
+    }
+}
+
+/// Calls `visit` with the dense index of every voxel the straight segment between two voxel
+/// centres passes through (both ends included), stopping early when `visit` returns false;
+/// returns false when stopped or when the segment leaves the region.
+fn segment_voxels(
+    field: &CostField,
+    from: VoxelKey,
+    to: VoxelKey,
+    mut visit: impl FnMut(usize) -> bool,
+) -> bool {
+    let resolution = field.resolution();
+    let region = field.region();
+    let mut ok = true;
+    walk_ray(
+        &resolution,
+        &resolution.center(from),
+        &resolution.center(to),
+        from,
+        to,
+        |key| {
+            if ok {
+                ok = region.index_of(key).is_some_and(&mut visit);
+            }
+        },
+    );
+    ok && region.index_of(to).is_some_and(visit)
+}
+
+/// Greedy line-of-sight shortcutting: from each kept waypoint, jump to the farthest later
+/// voxel of the path whose straight segment crosses only traversable voxels.
+fn shortcut(field: &CostField, voxels: &[VoxelKey]) -> Vec<VoxelKey> {
+    let mut kept = vec![voxels[0]];
+    let mut anchor = 0;
+    while anchor + 1 < voxels.len() {
+        let mut next = anchor + 1;
+        for candidate in (anchor + 2..voxels.len()).rev() {
+            if segment_voxels(field, voxels[anchor], voxels[candidate], |i| {
+                field.is_traversable(i)
+            }) {
+                next = candidate;
+                break;
+            }
+        }
+        kept.push(voxels[next]);
+        anchor = next;
+    }
+    kept
+}

@@ -1,0 +1,29 @@
+//! Planning through the maps: safety queries, a cost field with exact clearance, and A* over the
+//! implicit 26-connected voxel graph.
+//!
+//! Every map reports the same measures, so everything here runs on the fuzzy map and on both
+//! baselines through [`VoxelMap`](crate::VoxelMap).
+//!
+//! 1. [`PlannerConfig`] holds every threshold and the unknown-space policy in one value.
+//! 2. [`queries`](SafetyQueries) answer "is this point safe for a vehicle of radius r", "where is
+//!    the nearest safe voxel", "which voxels of this box are safe".
+//! 3. [`CostField`] turns a map region into traversability, safety and clearance (an exact
+//!    Euclidean distance transform to the nearest blocked voxel), and step costs
+//!    `length × (1 + k (1 - S))` plus a clearance penalty.
+//! 4. [`VoxelGraph`] exposes the field through petgraph's graph traits (no graph is built), so
+//!    petgraph's own `astar` and `dijkstra` run on it; [`plan_path`] runs a dense-array A* with a
+//!    consistent heuristic over the same graph, then shortcuts the path by line of sight.
+
+mod astar;
+mod config;
+mod cost_field;
+mod edt;
+mod graph;
+mod queries;
+
+pub use astar::{Path, PlanError, plan_in_field, plan_path};
+pub use config::{PlannerConfig, UnknownPolicy};
+pub use cost_field::{CostField, PlanningRegion};
+pub use edt::squared_distance_transform;
+pub use graph::{VoxelEdge, VoxelGraph};
+pub use queries::SafetyQueries;
