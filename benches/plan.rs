@@ -4,45 +4,38 @@
 //! Run: `cargo bench --bench plan`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use fuzzyvox::map::FunctionMap;
 use fuzzyvox::plan::{CostField, PlannerConfig, PlanningRegion, VoxelGraph, plan_in_field};
-use fuzzyvox::{
-    DepthFrame, IntegrationOptions, IntegrationStats, MeasureConfig, Memberships, PointCloud,
-    Resolution, VoxelCounts, VoxelKey, VoxelMap,
-};
+use fuzzyvox::{Memberships, Resolution, VoxelKey};
 use ordered_float::OrderedFloat;
 use petgraph::visit::{EdgeRef, IntoEdges};
 
-/// A 20 × 20 × 4 m forest at 0.1 m: free space (μE = 0.9) with round trunks of radius 0.3 m
-/// on a jittered grid of `spacing` metres (about four in five grid points hold a trunk).
-struct Forest {
-    resolution: Resolution,
-    measures: MeasureConfig,
-    spacing: f64,
+/// Whether a trunk of radius 0.3 m stands at `(x, y)` in a forest on a jittered grid of
+/// `spacing` metres (about four in five grid points hold a trunk).
+fn trunk_at(x: f64, y: f64, spacing: f64) -> bool {
+    let g = spacing;
+    let (cx, cy) = ((x / g).round(), (y / g).round());
+    let hash = ((cx as i64 * 73_856_093) ^ (cy as i64 * 19_349_663)).rem_euclid(97) as f64;
+    let jitter = 0.4 * g;
+    let (px, py) = (
+        cx * g + (hash / 97.0 - 0.5) * jitter,
+        cy * g + ((hash * 7.0) % 97.0 / 97.0 - 0.5) * jitter,
+    );
+    hash > 20.0 && (x - px).hypot(y - py) < 0.3
 }
 
-impl Forest {
-    fn pillar_near(&self, x: f64, y: f64) -> bool {
-        let g = self.spacing;
-        let (cx, cy) = ((x / g).round(), (y / g).round());
-        let hash = ((cx as i64 * 73_856_093) ^ (cy as i64 * 19_349_663)).rem_euclid(97) as f64;
-        let (px, py) = (
-            cx * 1.5 + (hash / 97.0 - 0.5) * 0.6,
-            cy * 1.5 + ((hash * 7.0) % 97.0 / 97.0 - 0.5) * 0.6,
-        );
-        hash > 20.0 && (x - px).hypot(y - py) < 0.3
+fn cross_region(c: &mut Criterion) {
+    for (name, spacing) in [("trees_3m", 3.0), ("dense_trees_1.5m", 1.5)] {
+        bench_forest(c, name, spacing);
     }
 }
 
-impl VoxelMap for Forest {
-    fn resolution(&self) -> Resolution {
-        self.resolution
-    }
-    fn measure_config(&self) -> &MeasureConfig {
-        &self.measures
-    }
-    fn memberships_at(&self, key: VoxelKey) -> Memberships {
-        let c = self.resolution.center(key);
-        if self.pillar_near(c.x, c.y) {
+fn bench_forest(c: &mut Criterion, name: &str, spacing: f64) {
+    // A 20 × 20 × 4 m forest at 0.1 m: free space (μE = 0.9) between the trunks.
+    let resolution = Resolution::new(0.1).unwrap();
+    let forest = FunctionMap::new(resolution, move |key| {
+        let c = resolution.center(key);
+        if trunk_at(c.x, c.y, spacing) {
             Memberships {
                 occupied: 0.9,
                 free: 0.0,
@@ -53,44 +46,7 @@ impl VoxelMap for Forest {
                 free: 0.9,
             }
         }
-    }
-    fn integrate_cloud(
-        &mut self,
-        _: &PointCloud,
-        _: &IntegrationOptions,
-    ) -> fuzzyvox::Result<IntegrationStats> {
-        Ok(IntegrationStats::default())
-    }
-    fn integrate_depth(
-        &mut self,
-        _: &DepthFrame,
-        _: &IntegrationOptions,
-    ) -> fuzzyvox::Result<IntegrationStats> {
-        Ok(IntegrationStats::default())
-    }
-    fn counts(&self) -> VoxelCounts {
-        VoxelCounts::default()
-    }
-    fn memory_bytes(&self) -> usize {
-        0
-    }
-    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
-        Box::new(std::iter::empty())
-    }
-}
-
-fn cross_region(c: &mut Criterion) {
-    for (name, spacing) in [("trees_3m", 3.0), ("dense_trees_1.5m", 1.5)] {
-        bench_forest(c, name, spacing);
-    }
-}
-
-fn bench_forest(c: &mut Criterion, name: &str, spacing: f64) {
-    let forest = Forest {
-        resolution: Resolution::new(0.1).unwrap(),
-        measures: MeasureConfig::default(),
-        spacing,
-    };
+    });
     let region = PlanningRegion::new(VoxelKey::new(0, 0, 0), VoxelKey::new(199, 199, 39)).unwrap();
     let config = PlannerConfig {
         vehicle_radius: 0.2,

@@ -1,55 +1,26 @@
 //! Planning: cost field, A* through petgraph's traits, shortcutting, typed failures, queries.
 
+use fuzzyvox::map::FunctionMap;
 use fuzzyvox::plan::{
     CostField, PlanError, PlannerConfig, PlanningRegion, SafetyQueries, UnknownPolicy, VoxelGraph,
     plan_in_field, plan_path,
 };
 use fuzzyvox::{
-    DepthFrame, IntegrationOptions, IntegrationStats, KeyBox, MeasureConfig, Memberships,
-    PointCloud, Resolution, VoxelCounts, VoxelKey, VoxelMap,
+    IntegrationOptions, KeyBox, Memberships, PointCloud, Resolution, VoxelKey, VoxelMap,
 };
 use nalgebra::Point3;
 
 /// A synthetic map: a 10 × 6 × 3 m room of free space (μE = 0.95) with a wall across it at
 /// x = 5 m, optionally with a door; everything outside the room is unknown.
-struct Room {
-    resolution: Resolution,
-    measures: MeasureConfig,
-    door: bool,
-}
-
-impl Room {
-    fn new(door: bool) -> Self {
-        Self {
-            resolution: Resolution::new(0.1).unwrap(),
-            measures: MeasureConfig::default(),
-            door,
-        }
-    }
-
-    fn wall_at(&self, p: &Point3<f64>) -> bool {
-        let in_wall = (4.9..5.1).contains(&p.x);
-        let in_door = (2.5..3.5).contains(&p.y) && p.z < 2.0;
-        in_wall && !(self.door && in_door)
-    }
-}
-
-impl VoxelMap for Room {
-    fn resolution(&self) -> Resolution {
-        self.resolution
-    }
-
-    fn measure_config(&self) -> &MeasureConfig {
-        &self.measures
-    }
-
-    fn memberships_at(&self, key: VoxelKey) -> Memberships {
-        let c = self.resolution.center(key);
+fn room(door: bool) -> impl VoxelMap {
+    let resolution = Resolution::new(0.1).unwrap();
+    FunctionMap::new(resolution, move |key| {
+        let c = resolution.center(key);
         let inside =
             (0.0..10.0).contains(&c.x) && (0.0..6.0).contains(&c.y) && (0.0..3.0).contains(&c.z);
         if !inside {
             Memberships::default()
-        } else if self.wall_at(&c) {
+        } else if wall_at(&c, door) {
             Memberships {
                 occupied: 0.9,
                 free: 0.0,
@@ -60,35 +31,13 @@ impl VoxelMap for Room {
                 free: 0.95,
             }
         }
-    }
+    })
+}
 
-    fn integrate_cloud(
-        &mut self,
-        _: &PointCloud,
-        _: &IntegrationOptions,
-    ) -> fuzzyvox::Result<IntegrationStats> {
-        Ok(IntegrationStats::default())
-    }
-
-    fn integrate_depth(
-        &mut self,
-        _: &DepthFrame,
-        _: &IntegrationOptions,
-    ) -> fuzzyvox::Result<IntegrationStats> {
-        Ok(IntegrationStats::default())
-    }
-
-    fn counts(&self) -> VoxelCounts {
-        VoxelCounts::default()
-    }
-
-    fn memory_bytes(&self) -> usize {
-        0
-    }
-
-    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
-        Box::new(std::iter::empty())
-    }
+fn wall_at(p: &Point3<f64>, door: bool) -> bool {
+    let in_wall = (4.9..5.1).contains(&p.x);
+    let in_door = (2.5..3.5).contains(&p.y) && p.z < 2.0;
+    in_wall && !(door && in_door)
 }
 
 fn config() -> PlannerConfig {
@@ -99,8 +48,8 @@ fn config() -> PlannerConfig {
 }
 
 /// Distance from a point to the nearest wall voxel's box.
-fn distance_to_wall(room: &Room, p: &Point3<f64>) -> f64 {
-    let r = room.resolution;
+fn distance_to_wall(room: &impl VoxelMap, p: &Point3<f64>) -> f64 {
+    let r = room.resolution();
     let key = r.key_of(p).unwrap();
     let mut best = f64::INFINITY;
     for dz in -8..=8 {
@@ -120,7 +69,7 @@ fn distance_to_wall(room: &Room, p: &Point3<f64>) -> f64 {
 
 #[test]
 fn path_goes_through_the_door_and_keeps_the_vehicle_radius() {
-    let room = Room::new(true);
+    let room = room(true);
     let (from, to) = (Point3::new(2.0, 1.0, 1.0), Point3::new(8.0, 5.0, 1.5));
     let path = plan_path(&room, &from, &to, &config()).unwrap();
     assert!(
@@ -147,8 +96,8 @@ fn path_goes_through_the_door_and_keeps_the_vehicle_radius() {
 
 #[test]
 fn petgraph_astar_runs_on_the_implicit_graph_and_agrees() {
-    let room = Room::new(true);
-    let r = room.resolution;
+    let room = room(true);
+    let r = room.resolution();
     let region = PlanningRegion::new(VoxelKey::new(0, 0, 5), VoxelKey::new(99, 59, 15)).unwrap();
     let field = CostField::build(&room, region, config()).unwrap();
     let (start, goal) = (VoxelKey::new(20, 10, 10), VoxelKey::new(80, 50, 10));
@@ -175,7 +124,7 @@ fn petgraph_astar_runs_on_the_implicit_graph_and_agrees() {
 
 #[test]
 fn failures_are_typed() {
-    let closed = Room::new(false);
+    let closed = room(false);
     let cfg = config();
     let result = plan_path(
         &closed,
@@ -187,7 +136,7 @@ fn failures_are_typed() {
         matches!(result, Err(PlanError::Disconnected { .. })),
         "{result:?}"
     );
-    let open = Room::new(true);
+    let open = room(true);
     let in_wall = plan_path(
         &open,
         &Point3::new(5.0, 1.0, 1.0),
@@ -243,7 +192,7 @@ fn failures_are_typed() {
 #[test]
 fn unknown_space_is_forbidden_or_costed() {
     // Going from inside the room to a point outside it crosses unknown space.
-    let room = Room::new(false);
+    let room = room(false);
     let (from, to) = (Point3::new(2.0, 1.0, 1.0), Point3::new(8.0, 1.0, 1.0));
     let forbid = plan_path(&room, &from, &to, &config());
     assert!(
@@ -266,7 +215,7 @@ fn unknown_space_is_forbidden_or_costed() {
 
 #[test]
 fn safety_queries() {
-    let room = Room::new(true);
+    let room = room(true);
     let cfg = config();
     assert!(
         room.is_safe(&Point3::new(2.0, 1.0, 1.0), 0.3, &cfg)
@@ -294,7 +243,7 @@ fn safety_queries() {
             .unwrap()
             .is_none()
     );
-    let r = room.resolution;
+    let r = room.resolution();
     let region = KeyBox::from_points(
         &r,
         &Point3::new(4.55, 0.55, 0.55),

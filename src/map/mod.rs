@@ -4,6 +4,7 @@ mod alpha;
 mod any;
 mod config;
 mod counts;
+mod function;
 mod fuzzy;
 mod logodds;
 
@@ -11,6 +12,7 @@ pub use alpha::{AlphaConfig, AlphaCutMap};
 pub use any::AnyMap;
 pub use config::FuzzyConfig;
 pub use counts::VoxelCounts;
+pub use function::FunctionMap;
 pub use fuzzy::FuzzyMap;
 pub use logodds::{LogOdds, LogOddsConfig, LogOddsMap};
 

@@ -1,0 +1,89 @@
+use super::VoxelMap;
+use super::counts::VoxelCounts;
+use crate::error::{Error, Result};
+use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud};
+use crate::measures::{MeasureConfig, Memberships};
+use crate::storage::{Resolution, VoxelKey};
+
+/// A read-only map whose memberships come from a function of the voxel key: ground truth from
+/// a scene model, a synthetic world for tests and benchmarks, or a view computed from another
+/// source. Planners and metrics run on it like on any map; it stores nothing, so it has no
+/// cells to list or count, and integrating into it is an error.
+///
+/// ```
+/// use fuzzyvox::map::FunctionMap;
+/// use fuzzyvox::{Memberships, Resolution, VoxelClass, VoxelKey, VoxelMap};
+///
+/// // Free everywhere except a wall at x = 0.
+/// let map = FunctionMap::new(Resolution::new(0.1)?, |k: VoxelKey| match k.x {
+///     0 => Memberships { occupied: 1.0, free: 0.0 },
+///     _ => Memberships { occupied: 0.0, free: 1.0 },
+/// });
+/// assert_eq!(map.class_at(VoxelKey::new(0, 5, 5)), VoxelClass::Occupied);
+/// assert_eq!(map.class_at(VoxelKey::new(3, 5, 5)), VoxelClass::Free);
+/// # Ok::<(), fuzzyvox::Error>(())
+/// ```
+pub struct FunctionMap<F> {
+    resolution: Resolution,
+    measures: MeasureConfig,
+    memberships: F,
+}
+
+impl<F: Fn(VoxelKey) -> Memberships + Send + Sync> FunctionMap<F> {
+    /// A map with the default measure configuration.
+    pub fn new(resolution: Resolution, memberships: F) -> Self {
+        Self {
+            resolution,
+            measures: MeasureConfig::default(),
+            memberships,
+        }
+    }
+
+    /// The same map with another measure configuration.
+    pub fn with_measures(mut self, measures: MeasureConfig) -> Result<Self> {
+        self.measures = measures.validate()?;
+        Ok(self)
+    }
+}
+
+impl<F: Fn(VoxelKey) -> Memberships + Send + Sync> VoxelMap for FunctionMap<F> {
+    fn resolution(&self) -> Resolution {
+        self.resolution
+    }
+
+    fn measure_config(&self) -> &MeasureConfig {
+        &self.measures
+    }
+
+    fn memberships_at(&self, key: VoxelKey) -> Memberships {
+        (self.memberships)(key)
+    }
+
+    fn integrate_cloud(
+        &mut self,
+        _: &PointCloud,
+        _: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        Err(Error::Incompatible("a function map is read-only".into()))
+    }
+
+    fn integrate_depth(
+        &mut self,
+        _: &DepthFrame,
+        _: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        Err(Error::Incompatible("a function map is read-only".into()))
+    }
+
+    fn counts(&self) -> VoxelCounts {
+        VoxelCounts::default()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        0
+    }
+
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
+        Box::new(std::iter::empty())
+    }
+}
