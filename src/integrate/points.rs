@@ -31,15 +31,13 @@ pub fn cloud_evidence(
     let options = options.validate()?;
     let origin = cloud.origin();
     let origin_key = resolution.key_of(&origin)?;
-    let rays: Vec<Option<Ray>> = cloud
+    let ray_of = |p: &Point3<f64>| Ray::new(&origin, p, options.max_range);
+    // Validate every end key first, so that a bad point fails the call before any work. Rays
+    // are made on the fly, here and below, so memory does not grow with the cloud.
+    if let Some(ray) = cloud
         .points()
         .par_iter()
-        .map(|p| Ray::new(&origin, p, options.max_range))
-        .collect();
-    // Validate every end key first, so that a bad point fails the call before any work.
-    if let Some(ray) = rays
-        .par_iter()
-        .flatten()
+        .filter_map(ray_of)
         .find_first(|ray| resolution.try_key_of(&ray.end).is_none())
     {
         return Err(Error::OutOfKeyRange {
@@ -52,27 +50,39 @@ pub fn cloud_evidence(
     // `fold` keeps one partial scan per piece of work that rayon schedules (a few per thread,
     // balanced by work stealing); `max` combines them exactly, so neither the split nor the
     // thread count changes the result.
-    let evidence = rays
+    let (evidence, stats) = cloud
+        .points()
         .par_chunks(CHUNK)
         .enumerate()
-        .fold(ScanEvidence::new, |mut scan, (chunk_index, chunk)| {
-            let mut acc = AccessorMut::new(&mut scan);
-            for (offset, ray) in chunk.iter().enumerate() {
-                if let Some(ray) = ray {
+        .fold(
+            || (ScanEvidence::new(), IntegrationStats::default()),
+            |(mut scan, mut stats), (chunk_index, chunk)| {
+                let mut acc = AccessorMut::new(&mut scan);
+                for (offset, point) in chunk.iter().enumerate() {
+                    let Some(ray) = ray_of(point) else {
+                        stats.skipped += 1;
+                        continue;
+                    };
+                    stats.integrated += 1;
+                    stats.clipped += usize::from(ray.clipped);
                     let c = cloud.confidence_of(chunk_index * CHUNK + offset);
                     ray.deposit(&mut acc, resolution, origin_key, model, operator, c);
                 }
-            }
-            scan
-        })
-        .reduce(ScanEvidence::new, merge_max);
-    let integrated = rays.iter().flatten().count();
-    let stats = IntegrationStats {
-        integrated,
-        skipped: rays.len() - integrated,
-        clipped: rays.iter().flatten().filter(|r| r.clipped).count(),
-        voxels_updated: 0,
-    };
+                (scan, stats)
+            },
+        )
+        .reduce(
+            || (ScanEvidence::new(), IntegrationStats::default()),
+            |(a, sa), (b, sb)| {
+                let stats = IntegrationStats {
+                    integrated: sa.integrated + sb.integrated,
+                    skipped: sa.skipped + sb.skipped,
+                    clipped: sa.clipped + sb.clipped,
+                    voxels_updated: 0,
+                };
+                (merge_max(a, b), stats)
+            },
+        );
     Ok((evidence, stats))
 }
 
