@@ -40,6 +40,7 @@ pub mod map;
 pub mod measures;
 pub mod ops;
 pub mod plan;
+pub mod sim;
 pub mod storage;
 
 pub use error::{Error, FormatError, Result};

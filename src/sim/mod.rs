@@ -1,0 +1,16 @@
+//! A small ray-cast world with exact ground truth, for experiments the real world cannot give:
+//! a [`Scene`] of parry3d shapes found through a BVH, a [`render`]er that makes textured images
+//! the depth stage can match (texture fixed to world coordinates, so views agree; a smooth,
+//! texture-less sky, where matching fails as it does for real UAV footage) with their true
+//! depth, and the camera [`trajectory`] patterns of the paper's scenarios.
+//!
+//! Everything is deterministic for a seed: the same scene, camera and seed give the same image
+//! bit for bit, on any number of threads.
+
+mod render;
+mod scene;
+mod texture;
+pub mod trajectory;
+
+pub use render::{RenderedFrame, render};
+pub use scene::{Hit, Scene, SurfaceKind};
