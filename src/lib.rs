@@ -33,6 +33,7 @@
 #![forbid(unsafe_code)]
 
 mod error;
+pub mod eval;
 pub mod geometry;
 pub mod integrate;
 pub mod io;

@@ -1,0 +1,50 @@
+//! The simulator and the evaluation together: the gold standard (true depth, standard method)
+//! of a wall seen from strafing cameras agrees with the geometric truth.
+
+use fuzzyvox::eval::{GroundTruth, evaluate, gold_standard};
+use fuzzyvox::sim::trajectory::strafe;
+use fuzzyvox::sim::{Scene, SurfaceKind};
+use fuzzyvox::{PinholeIntrinsics, VoxelMap};
+use nalgebra::{Point3, Vector3};
+
+fn wall_scene() -> Scene {
+    let mut scene = Scene::new();
+    scene.add_ground(0.0, 200.0).add_box(
+        Point3::new(10.0, 0.0, 3.0),
+        Vector3::new(0.25, 8.0, 3.0),
+        0.0,
+        SurfaceKind::Wall,
+    );
+    scene
+}
+
+#[test]
+fn gold_standard_matches_the_geometric_truth() {
+    let scene = wall_scene();
+    let k = PinholeIntrinsics::new(160, 120, 120.0, 120.0, 79.5, 59.5).unwrap();
+    let poses = strafe(
+        Point3::new(0.0, -2.0, 2.0),
+        Vector3::y(),
+        Vector3::new(1.0, 0.0, -0.05),
+        0.5,
+        6,
+    );
+    let gold = gold_standard(&scene, &k, &poses, 0.2, 30.0).unwrap();
+    let truth = GroundTruth::from_scene(&scene, &gold);
+    assert!(truth.occupied_count() > 500, "{}", truth.occupied_count());
+    let metrics = evaluate(&gold, &truth, &scene);
+    eprintln!("gold standard against the geometric truth: {metrics:?}");
+    // The gold standard marks the voxels its rays end in; they meet the geometry.
+    assert!(metrics.occupied_precision > 0.95, "{metrics:?}");
+    assert!(metrics.occupied_recall > 0.5, "{metrics:?}");
+    assert_eq!(metrics.spurious_unknown, 0);
+    assert!(metrics.chamfer_m < 0.2, "{metrics:?}");
+    // Nothing is known behind the wall.
+    assert!(
+        !truth.is_observed(
+            gold.resolution()
+                .key_of(&Point3::new(12.0, 0.0, 2.0))
+                .unwrap()
+        )
+    );
+}
