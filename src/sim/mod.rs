@@ -8,6 +8,7 @@
 //! bit for bit, on any number of threads.
 
 mod render;
+pub mod scenario;
 mod scene;
 mod texture;
 pub mod trajectory;
