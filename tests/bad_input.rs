@@ -306,3 +306,76 @@ fn text_clouds_report_the_bad_line() {
     assert_eq!(cloud.confidence().unwrap(), &[0.5, 1.0, 0.2]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn baseline_and_planner_parameters_are_validated() {
+    use fuzzyvox::plan::{PlannerConfig, PlanningRegion, UnknownPolicy};
+    use fuzzyvox::{AlphaConfig, AlphaCutMap, LogOddsConfig, LogOddsMap, VoxelKey};
+    let mut c = LogOddsConfig::new(0.1).unwrap();
+    c.prob_hit = 1.0;
+    assert!(LogOddsMap::new(c).is_err());
+    let mut c = LogOddsConfig::new(0.1).unwrap();
+    c.clamp_min = 0.99;
+    assert!(LogOddsMap::new(c).is_err());
+    let mut c = LogOddsConfig::new(0.1).unwrap();
+    c.prob_miss = f64::NAN;
+    assert!(LogOddsMap::new(c).is_err());
+    let mut a = AlphaConfig::new(0.1).unwrap();
+    a.cuts = 0;
+    assert!(AlphaCutMap::new(a).is_err());
+    for bad in [
+        PlannerConfig {
+            vehicle_radius: -1.0,
+            ..PlannerConfig::default()
+        },
+        PlannerConfig {
+            safety_threshold: 1.5,
+            ..PlannerConfig::default()
+        },
+        PlannerConfig {
+            safety_weight: f32::NAN,
+            ..PlannerConfig::default()
+        },
+        PlannerConfig {
+            unknown: UnknownPolicy::Cost(f32::INFINITY),
+            ..PlannerConfig::default()
+        },
+    ] {
+        assert!(bad.validate().is_err(), "{bad:?}");
+    }
+    assert!(
+        PlanningRegion::new(
+            VoxelKey::new(0, 0, 0),
+            VoxelKey::new(10_000, 10_000, 10_000)
+        )
+        .is_err()
+    );
+}
+
+#[test]
+fn baseline_maps_are_unchanged_by_failed_calls() {
+    use fuzzyvox::{AlphaConfig, AlphaCutMap, LogOddsConfig, LogOddsMap};
+    let bad = PointCloud::new(
+        Point3::origin(),
+        vec![Point3::new(1.0, 0.0, 0.0), Point3::new(0.0, 1e300, 0.0)],
+    )
+    .unwrap();
+    let scan = room_scan(Point3::origin(), 300, 3);
+    let mut logodds = LogOddsMap::new(LogOddsConfig::new(0.1).unwrap()).unwrap();
+    logodds.integrate_cloud(&scan, &Default::default()).unwrap();
+    let before = logodds.to_bytes();
+    assert!(matches!(
+        logodds.integrate_cloud(&bad, &Default::default()),
+        Err(Error::OutOfKeyRange { .. })
+    ));
+    assert_eq!(logodds.to_bytes(), before);
+    let mut alpha = AlphaCutMap::new(AlphaConfig::new(0.1).unwrap()).unwrap();
+    alpha.integrate_cloud(&scan, &Default::default()).unwrap();
+    let before = alpha.to_bytes();
+    let options = IntegrationOptions {
+        max_range: Some(-2.0),
+    };
+    assert!(alpha.integrate_cloud(&scan, &options).is_err());
+    assert!(alpha.integrate_cloud(&bad, &Default::default()).is_err());
+    assert_eq!(alpha.to_bytes(), before);
+}
