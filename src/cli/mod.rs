@@ -4,6 +4,7 @@
 mod info;
 mod input;
 mod insert;
+mod stereo;
 
 use std::process::ExitCode;
 
@@ -21,6 +22,7 @@ struct Cli {
 enum Command {
     Insert(insert::InsertArgs),
     Info(info::InfoArgs),
+    Stereo(stereo::StereoArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -29,6 +31,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
+        Command::Stereo(args) => stereo::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

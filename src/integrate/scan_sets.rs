@@ -133,9 +133,14 @@ pub fn scan_sets(
     let origin = cloud.origin();
     resolution.key_of(&origin)?;
     let finite = |p: &Point3<f64>| p.iter().all(|v| v.is_finite());
-    if let Some(p) = cloud.points().par_iter().filter(|p| finite(p)).find_first(|p| {
-        resolution.try_key_of(p).is_none() || p.iter().any(|v| !(*v as f32).is_finite())
-    }) {
+    if let Some(p) = cloud
+        .points()
+        .par_iter()
+        .filter(|p| finite(p))
+        .find_first(|p| {
+            resolution.try_key_of(p).is_none() || p.iter().any(|v| !(*v as f32).is_finite())
+        })
+    {
         return Err(Error::OutOfKeyRange {
             x: p.x,
             y: p.y,

@@ -173,22 +173,23 @@ impl LogOddsMap {
     pub fn apply_sets(&mut self, sets: &ScanSets) -> usize {
         let (hit_update, miss, min, max) = (self.hit, self.miss, self.min, self.max);
         let measures = self.config.measures;
-        self.grid.update_blocks(sets.blocks().collect(), |block, flags| {
-            let mut updated = 0;
-            for (i, cell) in block.cells.iter_mut().enumerate() {
-                let (passed, hit) = flags.get(i);
-                if !(passed || hit) {
-                    continue;
+        self.grid
+            .update_blocks(sets.blocks().collect(), |block, flags| {
+                let mut updated = 0;
+                for (i, cell) in block.cells.iter_mut().enumerate() {
+                    let (passed, hit) = flags.get(i);
+                    if !(passed || hit) {
+                        continue;
+                    }
+                    let update = if hit { hit_update } else { miss };
+                    let current = if cell.is_observed() { cell.0 } else { 0.0 };
+                    // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
+                    cell.0 = (current + update).clamp(min, max);
+                    updated += 1;
                 }
-                let update = if hit { hit_update } else { miss };
-                let current = if cell.is_observed() { cell.0 } else { 0.0 };
-                // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
-                cell.0 = (current + update).clamp(min, max);
-                updated += 1;
-            }
-            block.refresh_summary(|c| measures.classify(c.memberships()));
-            updated
-        })
+                block.refresh_summary(|c| measures.classify(c.memberships()));
+                updated
+            })
     }
 
     /// Integrates the points that `include` selects as one scan.

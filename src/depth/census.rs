@@ -1,0 +1,81 @@
+//! Census transform (Zabih and Woodfill, ECCV 1994): each pixel becomes a bit string that says
+//! which neighbours are darker than it. Matching costs are Hamming distances between strings,
+//! which makes them robust to gain and bias differences between the two images.
+
+use rayon::prelude::*;
+
+use super::gray::GrayImage;
+
+/// Census window width (columns). 9 × 7 = 63 neighbours including the centre, which fits a
+/// `u64` (the centre's own bit is always 0, so 62 bits carry information).
+pub const CENSUS_WIDTH: usize = 9;
+/// Census window height (rows).
+pub const CENSUS_HEIGHT: usize = 7;
+/// The largest Hamming distance between two census strings.
+pub const CENSUS_MAX_COST: u8 = (CENSUS_WIDTH * CENSUS_HEIGHT) as u8;
+
+/// A census-transformed image: one `u64` per pixel, and whether the pixel had a value.
+#[derive(Clone, Debug)]
+pub struct CensusImage {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Row-major census strings.
+    pub codes: Vec<u64>,
+    /// Row-major validity: the pixel's own value is not `NaN`.
+    pub valid: Vec<bool>,
+}
+
+/// Computes the 9 × 7 census transform. Neighbours beyond the border repeat the border pixel
+/// (they then compare equal and give a 0 bit); `NaN` neighbours also give 0 bits.
+pub fn census_transform(image: &GrayImage) -> CensusImage {
+    let width = image.width() as usize;
+    let height = image.height() as usize;
+    let pixels = image.pixels();
+    let mut codes = vec![0u64; width * height];
+    let (rx, ry) = (CENSUS_WIDTH / 2, CENSUS_HEIGHT / 2);
+    codes
+        .par_chunks_mut(width)
+        .enumerate()
+        .for_each(|(y, out)| {
+            // The clamped source rows of the window, top to bottom.
+            let rows: [&[f32]; CENSUS_HEIGHT] = std::array::from_fn(|k| {
+                let yy = (y + k).saturating_sub(ry).min(height - 1);
+                &pixels[yy * width..(yy + 1) * width]
+            });
+            let centre_row = rows[ry];
+            // Interior pixels, whose window needs no clamping: one pass per neighbour over the
+            // whole row, which the compiler vectorises.
+            let interior = rx..width.saturating_sub(rx).max(rx);
+            let centre = &centre_row[interior.clone()];
+            let codes = &mut out[interior.clone()];
+            for row in &rows {
+                for k in 0..CENSUS_WIDTH {
+                    let neighbours = &row[interior.start + k - rx..interior.end + k - rx];
+                    for ((code, &n), &c) in codes.iter_mut().zip(neighbours).zip(centre) {
+                        *code = (*code << 1) | u64::from(n < c);
+                    }
+                }
+            }
+            // Border columns, clamped.
+            for x in (0..width).filter(|x| !interior.contains(x)) {
+                let centre = centre_row[x];
+                let mut bits = 0u64;
+                for row in &rows {
+                    for k in 0..CENSUS_WIDTH {
+                        let xx = (x + k).saturating_sub(rx).min(width - 1);
+                        bits = (bits << 1) | u64::from(row[xx] < centre);
+                    }
+                }
+                out[x] = bits;
+            }
+        });
+    let valid = pixels.iter().map(|p| !p.is_nan()).collect();
+    CensusImage {
+        width,
+        height,
+        codes,
+        valid,
+    }
+}
