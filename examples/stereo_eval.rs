@@ -16,15 +16,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let ndisp: u32 = args.next().map_or(Ok(80), |s| s.parse())?;
     let window: u32 = args.next().map_or(Ok(9), |s| s.parse())?;
+    let lr: u32 = args.next().map_or(Ok(1), |s| s.parse())?;
+    let uniqueness: u32 = args.next().map_or(Ok(10), |s| s.parse())?;
+    let runs: usize = args.next().map_or(Ok(10), |s| s.parse())?;
     let pair = read_middlebury(&dir)?;
     let geometry = pair.calib.geometry()?;
     let mut params = DepthParams::default();
     params.matching.num_disparities = ndisp;
     params.matching.window_width = window;
     params.matching.window_height = window;
+    params.matching.left_right_tolerance = (lr > 0).then_some(lr);
+    params.matching.uniqueness_ratio = uniqueness;
     let mut best = f64::INFINITY;
     let mut result = None;
-    for _ in 0..10 {
+    for _ in 0..runs {
         let r = depth_from_rectified(&pair.left, &pair.right, &geometry, 1.0, &params)?;
         best = best.min(r.matching_seconds);
         result = Some(r);
@@ -36,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &truth.data,
         Some(result.frame.image().confidence()),
     )?;
-    println!("best of 10: {:.2} ms", best * 1e3);
+    println!("best of {runs}: {:.2} ms", best * 1e3);
     println!("{accuracy:?}");
     Ok(())
 }

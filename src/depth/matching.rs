@@ -2,7 +2,8 @@
 //! all, parabola sub-pixel refinement, a uniqueness test, a left-right consistency check, and the
 //! cost-curve disparity range that the interval stage turns into `P-` and `P+`.
 //!
-//! Layout and speed: costs are `u8` (at most 63) and window sums `u16` (at most 15 × 15 × 63),
+//! Layout and speed: costs are `u8` (at most 31) and window sums `i16` (at most 15 × 15 × 31 = 6975;
+//! signed because SSE2, the baseline of x86-64, has a signed 16-bit `min` but no unsigned one),
 //! stored with the disparity innermost so that every aggregation step is a straight loop over
 //! contiguous disparities that the compiler vectorises. The image is split into bands of rows;
 //! each band keeps a ring of horizontally aggregated rows and a running vertical sum, so the cost
@@ -11,11 +12,11 @@
 
 use rayon::prelude::*;
 
-use super::census::{CENSUS_MAX_COST, CensusImage, census_transform};
+use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
 use super::gray::GrayImage;
 use crate::error::{Error, Result};
 
-/// Largest supported aggregation window side; keeps window sums inside `u16`.
+/// Largest supported aggregation window side; keeps window sums inside `i16`.
 pub const MAX_WINDOW: u32 = 15;
 /// Largest supported number of disparities.
 pub const MAX_DISPARITIES: u32 = 1024;
@@ -209,15 +210,13 @@ pub(crate) fn match_census(
 }
 
 /// Census Hamming costs of image row `row` for every pixel and disparity, `x` major.
-fn cost_row(ctx: &Context, row: usize, costs: &mut [u8], reversed: &mut [u64]) {
+fn cost_row(ctx: &Context, row: usize, costs: &mut [u8], reversed: &mut [CensusCode]) {
     let (w, nd) = (ctx.width, ctx.disparities);
     let left = &ctx.left.codes[row * w..(row + 1) * w];
     // The right row reversed, so that increasing disparities read increasing addresses and the
     // XOR-popcount loop vectorises.
-    for (r, &code) in reversed
-        .iter_mut()
-        .zip(ctx.right.codes[row * w..(row + 1) * w].iter().rev())
-    {
+    let right = &ctx.right.codes[row * w..(row + 1) * w];
+    for (r, &code) in reversed.iter_mut().zip(right.iter().rev()) {
         *r = code;
     }
     for (x, (&code, out)) in left.iter().zip(costs.chunks_exact_mut(nd)).enumerate() {
@@ -235,44 +234,45 @@ fn cost_row(ctx: &Context, row: usize, costs: &mut [u8], reversed: &mut [u64]) {
     }
 }
 
-/// Horizontal box sums of one cost row: `sums[x][d] = Σ_{|k| <= rx} costs[clamp(x + k)][d]`.
-fn horizontal_sums(ctx: &Context, costs: &[u8], sums: &mut [u16], acc: &mut [u16]) {
+/// Horizontal box sums of one cost row: `sums[x][d] = Σ_{|k| <= rx} costs[clamp(x + k)][d]`,
+/// each column from the previous one by one addition and one subtraction.
+fn horizontal_sums(ctx: &Context, costs: &[u8], sums: &mut [i16]) {
     let (w, nd, rx) = (ctx.width, ctx.disparities, ctx.radius_x);
     let column = |x: isize| {
         let x = x.clamp(0, w as isize - 1) as usize;
         &costs[x * nd..(x + 1) * nd]
     };
-    acc.fill(0);
+    let first = &mut sums[..nd];
+    first.fill(0);
     for k in -(rx as isize)..=(rx as isize) {
-        for (a, &c) in acc.iter_mut().zip(column(k)) {
-            *a += u16::from(c);
+        for (a, &c) in first.iter_mut().zip(column(k)) {
+            *a += i16::from(c);
         }
     }
-    sums[..nd].copy_from_slice(acc);
-    for x in 1..w as isize {
-        let add = column(x + rx as isize);
-        let sub = column(x - rx as isize - 1);
-        for ((a, &p), &m) in acc.iter_mut().zip(add).zip(sub) {
-            *a = a.wrapping_add(u16::from(p)).wrapping_sub(u16::from(m));
+    for x in 1..w {
+        let (done, rest) = sums.split_at_mut(x * nd);
+        let previous = &done[(x - 1) * nd..];
+        let add = column(x as isize + rx as isize);
+        let sub = column(x as isize - rx as isize - 1);
+        for (((s, &q), &p), &m) in rest[..nd].iter_mut().zip(previous).zip(add).zip(sub) {
+            *s = q.wrapping_add(i16::from(p)).wrapping_sub(i16::from(m));
         }
-        let x = x as usize;
-        sums[x * nd..(x + 1) * nd].copy_from_slice(acc);
     }
 }
 
 /// Horizontally aggregated costs of image row `row` (clamped to the image).
-fn aggregated_row(ctx: &Context, row: isize, scratch: &mut Scratch, out: &mut [u16]) {
+fn aggregated_row(ctx: &Context, row: isize, scratch: &mut Scratch, out: &mut [i16]) {
     let row = row.clamp(0, ctx.height as isize - 1) as usize;
     cost_row(ctx, row, &mut scratch.costs, &mut scratch.reversed);
-    horizontal_sums(ctx, &scratch.costs, out, &mut scratch.acc);
+    horizontal_sums(ctx, &scratch.costs, out);
 }
 
 struct Scratch {
     costs: Vec<u8>,
-    acc: Vec<u16>,
-    row: Vec<u16>,
-    right_best: Vec<u32>,
-    reversed: Vec<u64>,
+    row: Vec<i16>,
+    right_cost: Vec<i16>,
+    right_best: Vec<i16>,
+    reversed: Vec<CensusCode>,
 }
 
 /// Matches rows `y0..y1` into `out` (those rows, row-major).
@@ -282,13 +282,13 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
     let rows = 2 * ctx.radius_y + 1;
     let mut scratch = Scratch {
         costs: vec![0; plane],
-        acc: vec![0; nd],
         row: vec![0; plane],
+        right_cost: vec![0; w],
         right_best: vec![0; w],
         reversed: vec![0; w],
     };
-    let mut ring = vec![0u16; rows * plane];
-    let mut vertical = vec![0u16; plane];
+    let mut ring = vec![0i16; rows * plane];
+    let mut vertical = vec![0i16; plane];
     let first = y0 as isize - ctx.radius_y as isize;
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds logical row first + k (mod).
     for (k, slot) in ring.chunks_exact_mut(plane).enumerate() {
@@ -318,27 +318,42 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
 }
 
 /// Winner takes all on one row of window sums, with the checks and the sub-pixel step.
-fn select_row(ctx: &Context, y: usize, sums: &[u16], scratch: &mut Scratch, out: &mut [Cell]) {
+fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out: &mut [Cell]) {
     let (w, nd, dmin) = (ctx.width, ctx.disparities, ctx.min_disparity);
     let params = ctx.params;
     // The right image's winners, for the left-right check: for right column xr, the best d
-    // over left columns x = xr + dmin + d. Costs and disparities are packed as
-    // `cost << 16 | d` so that one vectorisable `min` finds the best and breaks ties towards the
-    // smallest disparity.
+    // over left columns x = xr + dmin + d, ties to the smallest d. Two passes in 16-bit lanes
+    // (the minimum cost, then the smallest disparity reaching it), stored mirrored (slot
+    // w - 1 - xr) so that increasing disparities walk increasing slots and both loops
+    // vectorise.
     if params.left_right_tolerance.is_some() {
-        scratch.right_best.fill(u32::MAX);
-        for x in 0..w {
-            let (lo, hi) = valid_range(ctx, x);
-            if hi <= lo {
-                continue;
-            }
-            let column = &sums[x * nd + lo..x * nd + hi];
-            // Right columns for d = hi - 1 down to lo, in increasing column order.
-            let start = (x as isize - dmin - hi as isize + 1) as usize;
-            let end = (x as isize - dmin - lo as isize + 1) as usize;
-            let targets = &mut scratch.right_best[start..end];
-            for (r, (i, &c)) in targets.iter_mut().rev().zip(column.iter().enumerate()) {
-                *r = (*r).min((u32::from(c) << 16) | (lo + i) as u32);
+        scratch.right_cost.fill(i16::MAX);
+        scratch.right_best.fill(i16::MAX);
+        for pass in 0..2 {
+            for x in 0..w {
+                let (lo, hi) = valid_range(ctx, x);
+                if hi <= lo {
+                    continue;
+                }
+                let column = &sums[x * nd + lo..x * nd + hi];
+                let start = (w as isize - 1 - x as isize + dmin + lo as isize) as usize;
+                let slots = start..start + (hi - lo);
+                if pass == 0 {
+                    for (r, &c) in scratch.right_cost[slots].iter_mut().zip(column) {
+                        *r = (*r).min(c);
+                    }
+                } else {
+                    let costs = &scratch.right_cost[slots.clone()];
+                    let bests = &mut scratch.right_best[slots];
+                    for ((b, &m), (&c, &i)) in bests
+                        .iter_mut()
+                        .zip(costs)
+                        .zip(column.iter().zip(&INDEX[lo..]))
+                    {
+                        let mask = i16::from(c == m).wrapping_neg();
+                        *b = (*b).min((i & mask) | (i16::MAX & !mask));
+                    }
+                }
             }
         }
     }
@@ -348,51 +363,39 @@ fn select_row(ctx: &Context, y: usize, sums: &[u16], scratch: &mut Scratch, out:
             continue;
         }
         let (lo, hi) = valid_range(ctx, x);
-        if hi <= lo {
+        let column = &sums[x * nd + lo..x * nd + hi];
+        if column.is_empty() {
             continue;
         }
-        let column = &sums[x * nd + lo..x * nd + hi];
-        let packed = column
-            .iter()
-            .enumerate()
-            .map(|(i, &c)| (u32::from(c) << 16) | i as u32)
-            .min()
-            .unwrap_or(u32::MAX);
-        let best = (packed & 0xffff) as usize;
-        let best_cost = (packed >> 16) as u16;
+        let best_cost = min_value(column);
+        // Index reductions written as selects so that they vectorise (no early exit); the first
+        // index wins ties.
+        let best = first_index(column, |c| c == best_cost);
         let best_d = lo + best;
         let xr = (x as isize - dmin - best_d as isize) as usize;
         if !ctx.right.valid[y * w + xr] {
             continue;
         }
         if let Some(tolerance) = params.left_right_tolerance
-            && (scratch.right_best[xr] & 0xffff).abs_diff(best_d as u32) > tolerance
+            && u32::from(scratch.right_best[w - 1 - xr].abs_diff(best_d as i16)) > tolerance
         {
             continue;
         }
-        let best_cost = u32::from(best_cost);
+        let best_cost = best_cost as u32;
         if params.uniqueness_ratio > 0 {
             // The cheapest disparity more than one pixel from the best.
-            let before = column[..best.saturating_sub(1)].iter().min();
-            let after = column.get(best + 2..).and_then(|rest| rest.iter().min());
-            let rival = before.into_iter().chain(after).min();
-            if rival
-                .is_some_and(|&c| u32::from(c) * (100 - params.uniqueness_ratio) < best_cost * 100)
-            {
+            let before = min_value(&column[..best.saturating_sub(1)]);
+            let after = column.get(best + 2..).map_or(i16::MAX, min_value);
+            let rival = before.min(after) as u32;
+            if rival * (100 - params.uniqueness_ratio) < best_cost * 100 {
                 continue;
             }
         }
         // Cost-curve range: the span of all disparities within the tolerance of the best, so a
         // distant near-tie widens it (an ambiguous match is an uncertain one).
-        let threshold = (best_cost as f32 * (1.0 + params.range_tolerance)) as u32;
-        let low = column
-            .iter()
-            .position(|&c| u32::from(c) <= threshold)
-            .unwrap_or(best);
-        let high = column
-            .iter()
-            .rposition(|&c| u32::from(c) <= threshold)
-            .unwrap_or(best);
+        let threshold = (best_cost as f32 * (1.0 + params.range_tolerance)).min(32767.0) as i16;
+        let low = first_index(column, |c| c <= threshold);
+        let high = last_index(column, |c| c <= threshold);
         // Parabola through the best cost and its two neighbours.
         let mut offset = 0.0f32;
         if best > 0 && best + 1 < column.len() {
@@ -413,6 +416,81 @@ fn select_row(ctx: &Context, y: usize, sums: &[u16], scratch: &mut Scratch, out:
             high: base + high as f32,
         };
     }
+}
+
+/// `0, 1, 2, …` as `i16`: zipping with this instead of `enumerate` keeps index reductions in
+/// 16-bit lanes, so they vectorise eight or sixteen wide.
+static INDEX: [i16; MAX_DISPARITIES as usize] = {
+    let mut index = [0i16; MAX_DISPARITIES as usize];
+    let mut i = 0;
+    while i < index.len() {
+        index[i] = i as i16;
+        i += 1;
+    }
+    index
+};
+
+/// Lanes of the explicit reductions below: fixed-size accumulator arrays that the compiler maps
+/// to SIMD registers (an `Iterator::min` folds one element at a time).
+const LANES: usize = 16;
+
+/// The smallest value (`i16::MAX` for an empty slice).
+#[inline]
+fn min_value(values: &[i16]) -> i16 {
+    let mut acc = [i16::MAX; LANES];
+    let chunks = values.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for k in 0..LANES {
+            acc[k] = acc[k].min(chunk[k]);
+        }
+    }
+    acc.iter().chain(rest).copied().fold(i16::MAX, i16::min)
+}
+
+/// The first index whose value satisfies `test` (0 when none does).
+#[inline]
+fn first_index(values: &[i16], test: impl Fn(i16) -> bool) -> usize {
+    let mut acc = [i16::MAX; LANES];
+    let chunks = values.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for (chunk, index) in chunks.zip(INDEX.chunks_exact(LANES)) {
+        for k in 0..LANES {
+            // Branch-free select (all-ones mask when the test holds) so that this vectorises.
+            let mask = i16::from(test(chunk[k])).wrapping_neg();
+            acc[k] = acc[k].min((index[k] & mask) | (i16::MAX & !mask));
+        }
+    }
+    let tail = values.len() - rest.len();
+    let mut first = acc.iter().copied().fold(i16::MAX, i16::min);
+    for (&v, &i) in rest.iter().zip(&INDEX[tail..]) {
+        if test(v) {
+            first = first.min(i);
+        }
+    }
+    if first == i16::MAX { 0 } else { first as usize }
+}
+
+/// The last index whose value satisfies `test` (0 when none does).
+#[inline]
+fn last_index(values: &[i16], test: impl Fn(i16) -> bool) -> usize {
+    let mut acc = [0i16; LANES];
+    let chunks = values.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for (chunk, index) in chunks.zip(INDEX.chunks_exact(LANES)) {
+        for k in 0..LANES {
+            let mask = i16::from(test(chunk[k])).wrapping_neg();
+            acc[k] = acc[k].max(index[k] & mask);
+        }
+    }
+    let tail = values.len() - rest.len();
+    let mut last = acc.iter().copied().fold(0, i16::max);
+    for (&v, &i) in rest.iter().zip(&INDEX[tail..]) {
+        if test(v) {
+            last = last.max(i);
+        }
+    }
+    last as usize
 }
 
 /// Disparity indices `[lo, hi)` whose right pixel lies inside the image at column `x`.

@@ -13,7 +13,10 @@ mod pipeline;
 mod quality;
 mod rectify;
 
-pub use census::{CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusImage, census_transform};
+pub use census::{
+    CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
+    census_transform,
+};
 pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
 pub use gray::GrayImage;
 pub use interval::{IntervalMethod, IntervalParams, confidence, interval_image};
