@@ -16,7 +16,7 @@ use serde_json::json;
 /// folder) it reports accuracy: density and bad-1 / bad-2 over pixels with ground truth.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
-    fuzzyvox stereo --middlebury ../shared/data/middlebury-motorcycle --ndisp 80 --json\n  \
+    fuzzyvox stereo --middlebury ../shared/data/middlebury-motorcycle --ndisp 80 --repeat 20 --json\n  \
     fuzzyvox stereo --left im0.png --right im1.png --calib calib.txt --out depth/\n  \
     fuzzyvox stereo --middlebury DIR --interval fixed --delta 1 --out depth/ --json")]
 #[command(group(clap::ArgGroup::new("calibration").required(true).args(["calib", "middlebury"])))]
@@ -54,6 +54,10 @@ pub struct StereoArgs {
     /// Write disparity, depth, near, far and confidence as PFM and colour PNG here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Match this many times and report the fastest matching time (the first run also pays for
+    /// starting threads and touching fresh memory).
+    #[arg(long, default_value_t = 1)]
+    repeat: u32,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -107,7 +111,12 @@ pub fn run(args: StereoArgs) -> anyhow::Result<()> {
         Interval::Fixed => IntervalMethod::FixedDelta { delta: args.delta },
         Interval::Curve => IntervalMethod::CostCurve { delta: args.delta },
     };
-    let result = depth_from_rectified(&left, &right, &geometry, 1.0, &params)?;
+    let mut result = depth_from_rectified(&left, &right, &geometry, 1.0, &params)?;
+    let mut seconds = result.matching_seconds;
+    for _ in 1..args.repeat {
+        result = depth_from_rectified(&left, &right, &geometry, 1.0, &params)?;
+        seconds = seconds.min(result.matching_seconds);
+    }
     let disparity = &result.disparity;
     let image = result.frame.image();
     let accuracy: Option<Accuracy> = match &gt_path {
@@ -131,7 +140,8 @@ pub fn run(args: StereoArgs) -> anyhow::Result<()> {
             "height": disparity.height,
             "disparities": params.matching.num_disparities,
             "min_disparity": params.matching.min_disparity,
-            "seconds": result.matching_seconds,
+            "seconds": seconds,
+            "repeat": args.repeat.max(1),
             "threads": rayon::current_num_threads(),
             "density": density,
             "bad1_matched": a.map(|a| a.bad1_matched),
@@ -143,12 +153,13 @@ pub fn run(args: StereoArgs) -> anyhow::Result<()> {
         }));
     }
     println!(
-        "matched {}×{} over {} disparities in {:.1} ms ({} threads): density {density:.1}%",
+        "matched {}×{} over {} disparities in {:.1} ms ({} threads, best of {}): density {density:.1}%",
         disparity.width,
         disparity.height,
         params.matching.num_disparities,
-        result.matching_seconds * 1e3,
+        seconds * 1e3,
         rayon::current_num_threads(),
+        args.repeat.max(1),
     );
     if let Some(a) = accuracy {
         println!(

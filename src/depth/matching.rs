@@ -368,9 +368,19 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
             continue;
         }
         let best_cost = min_value(column);
-        // Index reductions written as selects so that they vectorise (no early exit); the first
-        // index wins ties.
-        let best = first_index(column, |c| c == best_cost);
+        // Thresholds in cost units: within the range tolerance of the best, and below the
+        // uniqueness bound `best · 100 / (100 - ratio)` (a rival is a cost strictly under it).
+        let range_threshold =
+            (f32::from(best_cost) * (1.0 + params.range_tolerance)).min(32766.0) as i16;
+        let unique_bound = if params.uniqueness_ratio > 0 {
+            // best_cost >= 0: window sums of non-negative costs.
+            let bound = (best_cost as u32 * 100).div_ceil(100 - params.uniqueness_ratio);
+            bound.min(i16::MAX as u32) as i16
+        } else {
+            0
+        };
+        let scan = scan_column(column, best_cost, range_threshold, unique_bound);
+        let best = scan.best;
         let best_d = lo + best;
         let xr = (x as isize - dmin - best_d as isize) as usize;
         if !ctx.right.valid[y * w + xr] {
@@ -381,21 +391,16 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
         {
             continue;
         }
-        let best_cost = best_cost as u32;
-        if params.uniqueness_ratio > 0 {
-            // The cheapest disparity more than one pixel from the best.
-            let before = min_value(&column[..best.saturating_sub(1)]);
-            let after = column.get(best + 2..).map_or(i16::MAX, min_value);
-            let rival = before.min(after) as u32;
-            if rival * (100 - params.uniqueness_ratio) < best_cost * 100 {
-                continue;
-            }
+        // Uniqueness: any disparity more than one pixel from the best under the bound.
+        if let Some((first, last)) = scan.unique_span
+            && (first + 1 < best || last > best + 1)
+        {
+            continue;
         }
         // Cost-curve range: the span of all disparities within the tolerance of the best, so a
         // distant near-tie widens it (an ambiguous match is an uncertain one).
-        let threshold = (best_cost as f32 * (1.0 + params.range_tolerance)).min(32767.0) as i16;
-        let low = first_index(column, |c| c <= threshold);
-        let high = last_index(column, |c| c <= threshold);
+        let (low, high) = (scan.low, scan.high);
+        let best_cost = best_cost as u32;
         // Parabola through the best cost and its two neighbours.
         let mut offset = 0.0f32;
         if best > 0 && best + 1 < column.len() {
@@ -448,49 +453,111 @@ fn min_value(values: &[i16]) -> i16 {
     acc.iter().chain(rest).copied().fold(i16::MAX, i16::min)
 }
 
-/// The first index whose value satisfies `test` (0 when none does).
-#[inline]
-fn first_index(values: &[i16], test: impl Fn(i16) -> bool) -> usize {
-    let mut acc = [i16::MAX; LANES];
-    let chunks = values.chunks_exact(LANES);
-    let rest = chunks.remainder();
-    for (chunk, index) in chunks.zip(INDEX.chunks_exact(LANES)) {
-        for k in 0..LANES {
-            // Branch-free select (all-ones mask when the test holds) so that this vectorises.
-            let mask = i16::from(test(chunk[k])).wrapping_neg();
-            acc[k] = acc[k].min((index[k] & mask) | (i16::MAX & !mask));
-        }
-    }
-    let tail = values.len() - rest.len();
-    let mut first = acc.iter().copied().fold(i16::MAX, i16::min);
-    for (&v, &i) in rest.iter().zip(&INDEX[tail..]) {
-        if test(v) {
-            first = first.min(i);
-        }
-    }
-    if first == i16::MAX { 0 } else { first as usize }
+/// Lanes of [`scan_column`]: one SSE register of `i16` per accumulator, so its five
+/// accumulators stay in registers.
+const SCAN_LANES: usize = 8;
+
+/// "No index" in the lane accumulators below.
+const NONE: i16 = i16::MAX;
+
+/// Lane accumulators of [`scan_column`].
+struct ScanLanes {
+    best: [i16; SCAN_LANES],
+    low: [i16; SCAN_LANES],
+    high: [i16; SCAN_LANES],
+    unique_low: [i16; SCAN_LANES],
+    unique_high: [i16; SCAN_LANES],
 }
 
-/// The last index whose value satisfies `test` (0 when none does).
+impl ScanLanes {
+    fn new() -> Self {
+        Self {
+            best: [NONE; SCAN_LANES],
+            low: [NONE; SCAN_LANES],
+            high: [-1; SCAN_LANES],
+            unique_low: [NONE; SCAN_LANES],
+            unique_high: [-1; SCAN_LANES],
+        }
+    }
+
+    /// One chunk; `(best_cost, range_threshold, unique_bound)`. Padding lanes carry the cost
+    /// `i16::MAX`, which no threshold accepts (thresholds are clamped below it or equal to the
+    /// best cost, itself far below it).
+    #[inline(always)]
+    fn step(&mut self, c: &[i16; SCAN_LANES], index: &[i16; SCAN_LANES], t: (i16, i16, i16)) {
+        for k in 0..SCAN_LANES {
+            let (c, i) = (c[k], index[k]);
+            let is_best = i16::from(c == t.0).wrapping_neg();
+            let in_range = i16::from(c <= t.1).wrapping_neg();
+            let rival = i16::from(c < t.2).wrapping_neg();
+            self.best[k] = self.best[k].min((i & is_best) | (NONE & !is_best));
+            self.low[k] = self.low[k].min((i & in_range) | (NONE & !in_range));
+            self.high[k] = self.high[k].max((i & in_range) | !in_range);
+            self.unique_low[k] = self.unique_low[k].min((i & rival) | (NONE & !rival));
+            self.unique_high[k] = self.unique_high[k].max((i & rival) | !rival);
+        }
+    }
+}
+
+/// What one pass over a pixel's cost column finds.
+struct ColumnScan {
+    /// First index of the best cost.
+    best: usize,
+    /// First index within the range threshold.
+    low: usize,
+    /// Last index within the range threshold.
+    high: usize,
+    /// First and last index strictly under the uniqueness bound, if any.
+    unique_span: Option<(usize, usize)>,
+}
+
+/// Finds, in one vectorised pass, the first index of `best_cost`, the span of costs at most
+/// `range_threshold` and the span of costs under `unique_bound`. The selects are branch-free
+/// (all-ones masks) so that the loop runs sixteen lanes at a time.
 #[inline]
-fn last_index(values: &[i16], test: impl Fn(i16) -> bool) -> usize {
-    let mut acc = [0i16; LANES];
-    let chunks = values.chunks_exact(LANES);
+fn scan_column(
+    column: &[i16],
+    best_cost: i16,
+    range_threshold: i16,
+    unique_bound: i16,
+) -> ColumnScan {
+    let mut acc = ScanLanes::new();
+    let chunks = column.chunks_exact(SCAN_LANES);
     let rest = chunks.remainder();
-    for (chunk, index) in chunks.zip(INDEX.chunks_exact(LANES)) {
-        for k in 0..LANES {
-            let mask = i16::from(test(chunk[k])).wrapping_neg();
-            acc[k] = acc[k].max(index[k] & mask);
-        }
+    let thresholds = (best_cost, range_threshold, unique_bound);
+    for (chunk, index) in chunks.zip(INDEX.chunks_exact(SCAN_LANES)) {
+        // Fixed-size copies: the compiler then knows the trip count and vectorises.
+        let chunk: &[i16; SCAN_LANES] = chunk.try_into().unwrap_or(&[NONE; SCAN_LANES]);
+        let index: &[i16; SCAN_LANES] = index.try_into().unwrap_or(&[NONE; SCAN_LANES]);
+        acc.step(chunk, index, thresholds);
     }
-    let tail = values.len() - rest.len();
-    let mut last = acc.iter().copied().fold(0, i16::max);
-    for (&v, &i) in rest.iter().zip(&INDEX[tail..]) {
-        if test(v) {
-            last = last.max(i);
-        }
+    if !rest.is_empty() {
+        // Pad the tail with a cost that no threshold accepts.
+        let mut chunk = [NONE; SCAN_LANES];
+        chunk[..rest.len()].copy_from_slice(rest);
+        let tail = column.len() - rest.len();
+        let mut index = [NONE; SCAN_LANES];
+        index[..rest.len()].copy_from_slice(&INDEX[tail..tail + rest.len()]);
+        acc.step(&chunk, &index, thresholds);
     }
-    last as usize
+    let ScanLanes {
+        best,
+        low,
+        high,
+        unique_low,
+        unique_high,
+    } = acc;
+    let min = |a: &[i16; SCAN_LANES]| a.iter().copied().fold(NONE, i16::min);
+    let max = |a: &[i16; SCAN_LANES]| a.iter().copied().fold(-1, i16::max);
+    let best = min(&best).max(0) as usize;
+    let unique_span =
+        (max(&unique_high) >= 0).then(|| (min(&unique_low) as usize, max(&unique_high) as usize));
+    ColumnScan {
+        best,
+        low: (min(&low) as usize).min(best),
+        high: (max(&high).max(0) as usize).max(best),
+        unique_span,
+    }
 }
 
 /// Disparity indices `[lo, hi)` whose right pixel lies inside the image at column `x`.
