@@ -80,6 +80,12 @@ pub enum Error {
         /// `P+` (m).
         far: f32,
     },
+    /// A stereo pair cannot be rectified usefully (depth stage).
+    #[error("the stereo pair cannot be rectified: {reason}")]
+    Unrectifiable {
+        /// Why.
+        reason: crate::depth::UnrectifiableReason,
+    },
     /// An aggregation operator's parameters are invalid or its name unknown.
     #[error(transparent)]
     Operator(#[from] OperatorError),

@@ -12,6 +12,7 @@
 //! - storage: sparse 8×8×8 blocks with `i32` keys ([`BlockGrid`], [`Resolution`]);
 //! - integration of [`PointCloud`]s (exact ray walk) and [`DepthFrame`]s with depth intervals
 //!   (projective frustum), into [`ScanEvidence`];
+//! - the [`depth`] stage: motion stereo from posed images to interval depth with confidence;
 //! - the dual-set [`FuzzyMap`] with its [`Measures`], merge, and crash-safe files.
 //!
 //! ```
@@ -32,6 +33,7 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod depth;
 mod error;
 pub mod eval;
 pub mod geometry;

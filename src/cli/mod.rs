@@ -6,6 +6,7 @@ mod info;
 mod input;
 mod insert;
 mod plan;
+mod stereo;
 
 use std::process::ExitCode;
 
@@ -25,6 +26,7 @@ enum Command {
     Info(info::InfoArgs),
     Export(export::ExportArgs),
     Plan(plan::PlanArgs),
+    Stereo(stereo::StereoArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -35,6 +37,7 @@ pub fn run() -> ExitCode {
         Command::Info(args) => info::run(args),
         Command::Export(args) => export::run(args),
         Command::Plan(args) => plan::run(args),
+        Command::Stereo(args) => stereo::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,7 +6,9 @@ mod cloud_text;
 mod fuzzy_file;
 mod logodds_file;
 mod mapfile;
+pub mod middlebury;
 pub mod octomap;
+pub mod pfm;
 pub mod rgbd;
 mod stored_blocks;
 

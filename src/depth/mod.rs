@@ -1,0 +1,29 @@
+//! The depth stage (EpiDepth-style motion stereo with one camera): pair selection, extrinsic
+//! quality `Q_ABD`, rectification, census block matching, and per-pixel depth intervals
+//! `P- <= P0 <= P+` with a confidence, output as a [`DepthFrame`](crate::DepthFrame) for the
+//! frustum integrator. See `docs/depth.md`.
+
+mod census;
+mod frame;
+mod gray;
+mod interval;
+mod matching;
+mod metrics;
+mod pipeline;
+mod quality;
+mod rectify;
+
+pub use census::{
+    CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
+    census_transform,
+};
+pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
+pub use gray::GrayImage;
+pub use interval::{IntervalMethod, IntervalParams, confidence, interval_image};
+pub use matching::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams, match_pair};
+pub use metrics::{Accuracy, evaluate};
+pub use pipeline::{
+    DepthParams, DepthResult, depth_from_pair, depth_from_rectified, depth_from_selected,
+};
+pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
+pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry, UnrectifiableReason};

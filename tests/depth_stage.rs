@@ -1,0 +1,290 @@
+//! The depth stage end to end on synthetic views with exact ground truth, rectification
+//! geometry, pair selection, and bad inputs.
+
+mod common;
+
+use fuzzyvox::depth::{
+    DepthParams, Frame, GrayImage, IntervalMethod, MatchParams, PairCriteria, PairSelector,
+    Rectification, Side, UnrectifiableReason, depth_from_pair, match_pair,
+};
+use fuzzyvox::{Error, PinholeIntrinsics};
+use nalgebra::{Isometry3, Point2, Point3, Translation3, UnitQuaternion, Vector3};
+
+/// The textured plane `z = 4 + 0.3 x` (world), seen by cameras near the origin looking along +z.
+fn plane_hit(origin: &Point3<f64>, direction: &Vector3<f64>) -> Option<Point3<f64>> {
+    // n · p = 4 with n = (-0.3, 0, 1).
+    let n = Vector3::new(-0.3, 0.0, 1.0);
+    let t = (4.0 - n.dot(&origin.coords)) / n.dot(direction);
+    (t > 0.0).then(|| origin + direction * t)
+}
+
+/// Value noise fixed to the plane (cells of 3 cm, bilinear), so both views see the same texture.
+fn texture(p: &Point3<f64>) -> f32 {
+    let hash = |i: i64, j: i64| {
+        let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+        z = (z ^ (z >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        ((z >> 40) & 0xff) as f64
+    };
+    let (u, v) = (p.x / 0.03, p.y / 0.03);
+    let (i, j) = (u.floor(), v.floor());
+    let (fu, fv) = (u - i, v - j);
+    let (i, j) = (i as i64, j as i64);
+    let top = hash(i, j) * (1.0 - fu) + hash(i + 1, j) * fu;
+    let bottom = hash(i, j + 1) * (1.0 - fu) + hash(i + 1, j + 1) * fu;
+    (top * (1.0 - fv) + bottom * fv) as f32
+}
+
+fn camera() -> PinholeIntrinsics {
+    PinholeIntrinsics::new(320, 240, 300.0, 300.0, 159.5, 119.5).unwrap()
+}
+
+fn render(k: &PinholeIntrinsics, pose: &Isometry3<f64>) -> GrayImage {
+    let origin = Point3::from(pose.translation.vector);
+    let mut pixels = Vec::new();
+    for v in 0..k.height() {
+        for u in 0..k.width() {
+            let ray = pose.rotation * k.back_project(f64::from(u), f64::from(v), 1.0).coords;
+            pixels.push(plane_hit(&origin, &ray).map_or(0.0, |p| texture(&p)));
+        }
+    }
+    GrayImage::new(k.width(), k.height(), pixels).unwrap()
+}
+
+fn pose(position: [f64; 3], yaw_degrees: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(position[0], position[1], position[2]),
+        UnitQuaternion::from_euler_angles(0.02, yaw_degrees.to_radians(), 0.01),
+    )
+}
+
+#[test]
+fn synthetic_plane_depth_lies_in_the_interval() {
+    let k = camera();
+    let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
+    let other_pose = pose([0.35, 0.02, 0.03], -2.0);
+    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 0.0).unwrap();
+    let other = Frame::new(render(&k, &other_pose), k, other_pose, 0.5).unwrap();
+    for method in [
+        IntervalMethod::FixedDelta { delta: 1.0 },
+        IntervalMethod::CostCurve { delta: 1.0 },
+    ] {
+        let mut params = DepthParams {
+            depth_range: Some((2.0, 12.0)),
+            ..DepthParams::default()
+        };
+        params.interval.method = method;
+        let result = depth_from_pair(&reference, &other, &params).unwrap();
+        let frame = &result.frame;
+        let image = frame.image();
+        let rect = frame.intrinsics();
+        let origin = Point3::from(frame.world_from_camera().translation.vector);
+        let (mut confident, mut inside) = (0usize, 0usize);
+        for i in 0..image.depth().len() {
+            let (near, depth, far) = (image.near()[i], image.depth()[i], image.far()[i]);
+            if near.is_finite() && depth.is_finite() {
+                assert!(near <= depth, "P- > P0 at {i}");
+            }
+            if depth.is_finite() && far.is_finite() {
+                assert!(depth <= far, "P0 > P+ at {i}");
+            }
+            if image.confidence()[i].is_nan() || image.confidence()[i] <= 0.0 {
+                continue;
+            }
+            let (u, v) = (
+                (i % rect.width() as usize) as f64,
+                (i / rect.width() as usize) as f64,
+            );
+            let ray = frame.world_from_camera().rotation * rect.back_project(u, v, 1.0).coords;
+            let hit = plane_hit(&origin, &ray).unwrap();
+            // Depth along the rectified optical axis.
+            let truth = (frame.world_from_camera().inverse() * hit).z as f32;
+            confident += 1;
+            inside += usize::from(near <= truth && truth <= far);
+        }
+        let share = inside as f64 / confident as f64;
+        assert!(
+            confident > 320 * 240 / 2,
+            "{method:?}: only {confident} confident pixels"
+        );
+        assert!(
+            share >= 0.95,
+            "{method:?}: {:.1}% of confident pixels contain the truth",
+            100.0 * share
+        );
+        assert!(result.quality > 0.9, "strafe quality {}", result.quality);
+    }
+}
+
+#[test]
+fn rectified_rows_agree_to_a_tenth_of_a_pixel() {
+    let k_ref = PinholeIntrinsics::new(640, 480, 520.0, 515.0, 330.0, 238.0).unwrap();
+    let k_other = PinholeIntrinsics::new(600, 450, 480.0, 485.0, 290.0, 230.0).unwrap();
+    let world_from_ref = pose([0.1, -0.2, 0.05], 3.0);
+    let world_from_other = Isometry3::from_parts(
+        Translation3::new(0.6, -0.1, 0.15),
+        UnitQuaternion::from_euler_angles(-0.05, -0.1, 0.04),
+    );
+    let rect = Rectification::new(&k_ref, &world_from_ref, &k_other, &world_from_other).unwrap();
+    let geometry = rect.geometry();
+    let mut rng = common::Rng::new(7);
+    let mut checked = 0;
+    for _ in 0..500 {
+        let p_ref = Point3::new(
+            rng.uniform(-2.0, 2.0),
+            rng.uniform(-1.5, 1.5),
+            rng.uniform(2.0, 20.0),
+        );
+        let world = world_from_ref * p_ref;
+        let (Some(a), Some(b)) = (
+            k_ref.project(&p_ref),
+            k_other.project(&(world_from_other.inverse() * world)),
+        ) else {
+            continue;
+        };
+        let ra = rect.rectify_point(Side::Reference, a).unwrap();
+        let rb = rect.rectify_point(Side::Other, b).unwrap();
+        assert!((ra.y - rb.y).abs() < 0.1, "rows {} vs {}", ra.y, rb.y);
+        // The disparity gives back the depth along the rectified axis.
+        let z = (geometry.world_from_reference().inverse() * world).z;
+        let depth = geometry.depth(ra.x - rb.x).unwrap();
+        assert!((depth - z).abs() < 1e-6 * z, "depth {depth} vs {z}");
+        checked += 1;
+    }
+    assert!(checked > 300);
+}
+
+#[test]
+fn pair_selector_prefers_the_best_quality() {
+    let k = camera();
+    let image = GrayImage::new(320, 240, vec![0.0; 320 * 240]).unwrap();
+    let mut selector = PairSelector::new(PairCriteria::default()).unwrap();
+    let frame =
+        |t: f64, position: [f64; 3]| Frame::new(image.clone(), k, pose(position, 0.0), t).unwrap();
+    assert!(
+        selector
+            .push(frame(0.0, [0.0, 0.0, 0.0]))
+            .unwrap()
+            .is_none()
+    );
+    // Forward motion: Q ≈ 0, but a valid partner.
+    let forward = selector.push(frame(0.1, [0.0, 0.0, 0.3])).unwrap().unwrap();
+    assert!(forward.quality.q < 0.2);
+    // Sideways from the first frame, forward-ish from the second: the first wins.
+    let pair = selector.push(frame(0.2, [0.3, 0.0, 0.0])).unwrap().unwrap();
+    assert_eq!(pair.other.timestamp(), 0.0);
+    assert!(pair.quality.q > 0.99);
+    // Out of the time window: nothing to pair with.
+    assert!(
+        selector
+            .push(frame(10.0, [0.6, 0.0, 0.0]))
+            .unwrap()
+            .is_none()
+    );
+    assert_eq!(selector.len(), 1);
+    // Time must not run backwards.
+    assert!(selector.push(frame(5.0, [0.6, 0.0, 0.0])).is_err());
+    assert!(
+        PairSelector::new(PairCriteria {
+            time_window: f64::NAN,
+            ..PairCriteria::default()
+        })
+        .is_err()
+    );
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    let k = camera();
+    let image = GrayImage::new(320, 240, vec![1.0; 320 * 240]).unwrap();
+    let small = GrayImage::new(160, 240, vec![1.0; 160 * 240]).unwrap();
+    // Different image sizes.
+    assert!(matches!(
+        match_pair(&image, &small, &MatchParams::default()),
+        Err(Error::SizeMismatch { .. })
+    ));
+    assert!(matches!(
+        Frame::new(small.clone(), k, Isometry3::identity(), 0.0),
+        Err(Error::SizeMismatch { .. })
+    ));
+    // Empty images.
+    assert!(matches!(GrayImage::new(0, 0, vec![]), Err(Error::Empty(_))));
+    assert!(matches!(GrayImage::new(4, 0, vec![]), Err(Error::Empty(_))));
+    // ndisp 0 and other bad parameters.
+    let zero = MatchParams {
+        num_disparities: 0,
+        ..MatchParams::default()
+    };
+    assert!(matches!(
+        match_pair(&image, &image, &zero),
+        Err(Error::InvalidParameter { .. })
+    ));
+    let even = MatchParams {
+        window_width: 8,
+        ..MatchParams::default()
+    };
+    assert!(matches!(
+        match_pair(&image, &image, &even),
+        Err(Error::InvalidParameter { .. })
+    ));
+    // NaN pose.
+    let mut nan = Isometry3::identity();
+    nan.translation.vector.x = f64::NAN;
+    assert!(matches!(
+        Frame::new(image.clone(), k, nan, 0.0),
+        Err(Error::InvalidPose(_))
+    ));
+    assert!(matches!(
+        Frame::new(image.clone(), k, Isometry3::identity(), f64::NAN),
+        Err(Error::NonFinite { .. })
+    ));
+    assert!(matches!(
+        Rectification::new(&k, &nan, &k, &Isometry3::identity()),
+        Err(Error::InvalidPose(_))
+    ));
+    let a = Frame::new(image.clone(), k, Isometry3::identity(), 0.0).unwrap();
+    // Zero baseline.
+    let same = Frame::new(image.clone(), k, Isometry3::identity(), 1.0).unwrap();
+    assert!(matches!(
+        depth_from_pair(&a, &same, &DepthParams::default()),
+        Err(Error::Unrectifiable {
+            reason: UnrectifiableReason::ZeroBaseline { .. }
+        })
+    ));
+    // Forward motion: the epipole is inside the image.
+    let ahead = Frame::new(image.clone(), k, pose([0.05, 0.0, 1.0], 0.0), 1.0).unwrap();
+    assert!(matches!(
+        depth_from_pair(&a, &ahead, &DepthParams::default()),
+        Err(Error::Unrectifiable {
+            reason: UnrectifiableReason::EpipoleInImage { .. }
+        })
+    ));
+    // Opposite views, sideways: no overlap.
+    let behind = Frame::new(
+        image.clone(),
+        k,
+        Isometry3::from_parts(
+            Translation3::new(1.0, 0.0, 0.0),
+            UnitQuaternion::from_euler_angles(0.0, std::f64::consts::PI, 0.0),
+        ),
+        1.0,
+    )
+    .unwrap();
+    assert!(matches!(
+        depth_from_pair(&a, &behind, &DepthParams::default()),
+        Err(Error::Unrectifiable {
+            reason: UnrectifiableReason::OppositeViews
+        })
+    ));
+    // A depth range that makes no sense.
+    let sideways = Frame::new(image, k, pose([0.3, 0.0, 0.0], 0.0), 1.0).unwrap();
+    let params = DepthParams {
+        depth_range: Some((5.0, 1.0)),
+        ..DepthParams::default()
+    };
+    assert!(matches!(
+        depth_from_pair(&a, &sideways, &params),
+        Err(Error::InvalidParameter { .. })
+    ));
+    let _ = Point2::new(0.0, 0.0);
+}
