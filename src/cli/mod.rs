@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Each command lives in its own file and only calls the
 //! library.
 
+mod eval;
 mod export;
 mod info;
 mod input;
@@ -25,6 +26,7 @@ enum Command {
     Insert(insert::InsertArgs),
     Info(info::InfoArgs),
     Export(export::ExportArgs),
+    Eval(eval::EvalArgs),
     Plan(plan::PlanArgs),
     Stereo(stereo::StereoArgs),
 }
@@ -36,6 +38,7 @@ pub fn run() -> ExitCode {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
         Command::Export(args) => export::run(args),
+        Command::Eval(args) => eval::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Stereo(args) => stereo::run(args),
     };

@@ -7,8 +7,10 @@
 //! unknown region (behind walls, in the sky); and the Chamfer distance from occupied voxel
 //! centres to the true surface.
 
+mod experiment;
 mod metrics;
 mod truth;
 
+pub use experiment::{ExperimentConfig, ExperimentReport, MapReport, run_experiment};
 pub use metrics::{MapMetrics, evaluate};
 pub use truth::{GroundTruth, gold_standard};

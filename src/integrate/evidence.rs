@@ -61,6 +61,12 @@ pub struct EvidenceModel {
     /// [`EvidenceModel::MAX_KERNEL_VOXELS`] voxels). 0 puts all occupied evidence in the end
     /// voxel. Default 0.002 rad (0.11°).
     pub angular_resolution: f64,
+    /// How fast a depth interval's occupied evidence falls as the interval widens: the peak is
+    /// `(2δ / (P+ - P- + 2δ))^interval_falloff`, δ half a voxel diagonal. 1 spreads one sharp
+    /// hit's evidence over the interval (a 13-voxel interval gives each voxel a thirteenth);
+    /// 0 ignores the width; in between, wide intervals commit less per voxel yet repeated views
+    /// build up faster. Default 1.
+    pub interval_falloff: f32,
 }
 
 impl EvidenceModel {
@@ -80,6 +86,13 @@ impl EvidenceModel {
                     expected: "an evidence gain in (0, 1]",
                 });
             }
+        }
+        if !(0.0..=1.0).contains(&self.interval_falloff) {
+            return Err(Error::InvalidParameter {
+                name: "interval_falloff",
+                value: f64::from(self.interval_falloff),
+                expected: "an exponent in [0, 1]",
+            });
         }
         finite("angular_resolution", self.angular_resolution)?;
         if !(0.0..=0.1).contains(&self.angular_resolution) {
@@ -111,6 +124,7 @@ impl Default for EvidenceModel {
             occupied_gain: 0.7,
             free_gain: 0.6,
             angular_resolution: 0.002,
+            interval_falloff: 1.0,
         }
     }
 }

@@ -27,8 +27,10 @@ const TILE: u32 = 8;
 /// - `z > P+ + δ`: nothing (occluded).
 ///
 /// `φ` is a tent that is flat within `δ` of `P0` and falls linearly to zero at `P- - δ` and
-/// `P+ + δ`; its height `2δ / (P+ - P- + 2δ)` keeps the evidence summed along the ray that of
-/// one sharp hit, so wide (far, uncertain) intervals commit less per voxel. A pixel whose depth
+/// `P+ + δ`; its height `(2δ / (P+ - P- + 2δ))^f` (`f` = [`EvidenceModel::interval_falloff`])
+/// makes wide (far, uncertain) intervals commit less per voxel: `f = 1` keeps the evidence
+/// summed along the ray that of one sharp hit, `f = 0` gives every voxel of the interval the full
+/// evidence. A pixel whose depth
 /// exceeds `max_range` clears free space up to `max_range` and marks nothing occupied. Invalid
 /// pixels contribute nothing.
 ///
@@ -108,6 +110,8 @@ struct PixelEvidence {
     free_until: f32,
     /// Voxels with `z` up to this can get any evidence.
     reach: f32,
+    /// Peak of the occupied kernel: `(2δ / (P+ - P- + 2δ))^falloff`.
+    height: f32,
     beyond_range: bool,
 }
 
@@ -130,11 +134,14 @@ impl PixelEvidence {
         } else {
             interval.far + delta
         };
+        let height = (2.0 * delta / (interval.far - interval.near + 2.0 * delta))
+            .powf(model.interval_falloff);
         Self {
             interval,
             free: model.free(operator, interval.confidence),
             free_until,
             reach,
+            height,
             beyond_range,
         }
     }
@@ -158,7 +165,7 @@ impl PixelEvidence {
             return None;
         }
         let p = &self.interval;
-        let height = 2.0 * delta / (p.far - p.near + 2.0 * delta);
+        let height = self.height;
         let (low, high) = (p.near - delta, p.far + delta);
         let shape = if (z - p.depth).abs() <= delta {
             1.0

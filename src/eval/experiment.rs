@@ -1,0 +1,199 @@
+//! The experiment runner: one scenario, identical depth-stage output fed to every map, metrics
+//! after every phase.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::metrics::{MapMetrics, evaluate};
+use super::truth::{GroundTruth, gold_standard};
+use crate::depth::{DepthParams, Frame, GrayImage, depth_from_pair};
+use crate::error::Result;
+use crate::integrate::{DepthFrame, IntegrationOptions};
+use crate::map::{
+    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
+};
+use crate::ops::{Family, TConorm};
+use crate::sim::render;
+use crate::sim::scenario::Scenario;
+
+/// Settings of an experiment.
+#[derive(Clone, Debug)]
+pub struct ExperimentConfig {
+    /// Voxel size of every map, metres.
+    pub resolution: f64,
+    /// Extra fuzzy maps, one per operator (the default fuzzy map uses the probabilistic sum).
+    pub operators: Vec<Family>,
+    /// The depth stage's settings (its depth range defaults to 1 m .. the scenario's range).
+    pub depth: DepthParams,
+    /// Seed of the sensor noise.
+    pub seed: u64,
+}
+
+impl Default for ExperimentConfig {
+    fn default() -> Self {
+        Self {
+            resolution: 0.2,
+            operators: Vec::new(),
+            depth: DepthParams::default(),
+            seed: 1,
+        }
+    }
+}
+
+/// Metrics of one map: at the end, and after each named phase.
+#[derive(Clone, Debug, Serialize)]
+pub struct MapReport {
+    /// At the end of the flight.
+    #[serde(flatten)]
+    pub metrics: MapMetrics,
+    /// After each phase, by name.
+    pub phases: BTreeMap<String, MapMetrics>,
+}
+
+/// What an experiment measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct ExperimentReport {
+    /// Scenario name.
+    pub scenario: String,
+    /// Pairs flown.
+    pub pairs: usize,
+    /// Pairs the depth stage could not use (and why, for the first few).
+    pub rejected_pairs: usize,
+    /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, `fuzzy:OP`.
+    pub maps: BTreeMap<String, MapReport>,
+    /// Truly occupied voxels in the observed region.
+    pub truth_occupied: usize,
+    /// Seconds spent rendering, in the depth stage, and integrating.
+    pub seconds: BTreeMap<String, f64>,
+}
+
+/// Runs a scenario: renders every pair, runs the depth stage once per pair, feeds the same
+/// depth frames to every map, and evaluates every map after each phase against the ground
+/// truth (the scene's geometry inside the region the gold standard observed).
+pub fn run_experiment(
+    scenario: &Scenario,
+    config: &ExperimentConfig,
+) -> Result<(ExperimentReport, Vec<(String, AnyMap)>)> {
+    let mut maps: Vec<(String, AnyMap)> = vec![
+        (
+            "logodds".into(),
+            AnyMap::LogOdds(LogOddsMap::new(LogOddsConfig::new(config.resolution)?)?),
+        ),
+        (
+            "alpha".into(),
+            AnyMap::Alpha(AlphaCutMap::new(AlphaConfig::new(config.resolution)?)?),
+        ),
+        (
+            "fuzzy".into(),
+            AnyMap::Fuzzy(FuzzyMap::new(FuzzyConfig::new(config.resolution)?)?),
+        ),
+    ];
+    for family in &config.operators {
+        let fuzzy = FuzzyConfig::new(config.resolution)?.with_operator(TConorm::new(*family)?);
+        maps.push((
+            format!("fuzzy:{family}"),
+            AnyMap::Fuzzy(FuzzyMap::new(fuzzy)?),
+        ));
+    }
+    let mut seconds = BTreeMap::new();
+    let started = Instant::now();
+    let references: Vec<_> = scenario.pairs.iter().map(|p| p.0).collect();
+    let gold = gold_standard(
+        &scenario.scene,
+        &scenario.intrinsics,
+        &references,
+        config.resolution,
+        scenario.max_range,
+    )?;
+    let truth = GroundTruth::from_scene(&scenario.scene, &gold);
+    seconds.insert("ground_truth".into(), started.elapsed().as_secs_f64());
+
+    let mut depth = config.depth.clone();
+    depth.depth_range.get_or_insert((1.0, scenario.max_range));
+    let options = IntegrationOptions {
+        max_range: Some(scenario.max_range),
+    };
+    let mut phase_metrics: BTreeMap<String, BTreeMap<String, MapMetrics>> = BTreeMap::new();
+    let (mut render_s, mut depth_s, mut integrate_s) = (0.0, 0.0, 0.0);
+    let mut rejected = 0;
+    for (phase, range) in &scenario.phases {
+        for index in range.clone() {
+            let Some((reference, other)) = scenario.pairs.get(index) else {
+                continue;
+            };
+            let t = Instant::now();
+            let seed = config
+                .seed
+                .wrapping_mul(1_000_003)
+                .wrapping_add(index as u64);
+            let views: Vec<_> = [(reference, 0u64), (other, 1)]
+                .par_iter()
+                .map(|(pose, side)| {
+                    render(
+                        &scenario.scene,
+                        &scenario.intrinsics,
+                        pose,
+                        seed * 2 + side,
+                        scenario.max_range * 4.0,
+                    )
+                })
+                .collect();
+            render_s += t.elapsed().as_secs_f64();
+            let frame = |i: usize, pose| -> Result<Frame> {
+                let v = &views[i];
+                Frame::new(
+                    GrayImage::new(v.width, v.height, v.image.clone())?,
+                    scenario.intrinsics,
+                    pose,
+                    index as f64,
+                )
+            };
+            let t = Instant::now();
+            let result = depth_from_pair(&frame(0, *reference)?, &frame(1, *other)?, &depth);
+            depth_s += t.elapsed().as_secs_f64();
+            let depth_frame: DepthFrame = match result {
+                Ok(result) => result.frame,
+                Err(_) => {
+                    rejected += 1;
+                    continue;
+                }
+            };
+            let t = Instant::now();
+            for (_, map) in maps.iter_mut() {
+                map.as_map_mut().integrate_depth(&depth_frame, &options)?;
+            }
+            integrate_s += t.elapsed().as_secs_f64();
+        }
+        for (name, map) in &maps {
+            phase_metrics.entry(name.clone()).or_default().insert(
+                (*phase).to_string(),
+                evaluate(map.as_map(), &truth, &scenario.scene),
+            );
+        }
+    }
+    seconds.insert("render".into(), render_s);
+    seconds.insert("depth_stage".into(), depth_s);
+    seconds.insert("integration".into(), integrate_s);
+    let maps_report = maps
+        .iter()
+        .map(|(name, map)| {
+            let phases = phase_metrics.remove(name).unwrap_or_default();
+            let metrics = evaluate(map.as_map(), &truth, &scenario.scene);
+            (name.clone(), MapReport { metrics, phases })
+        })
+        .collect();
+    Ok((
+        ExperimentReport {
+            scenario: scenario.name.to_string(),
+            pairs: scenario.pairs.len(),
+            rejected_pairs: rejected,
+            maps: maps_report,
+            truth_occupied: truth.occupied_count(),
+            seconds,
+        },
+        maps,
+    ))
+}
