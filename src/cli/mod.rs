@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Each command lives in its own file and only calls the
 //! library.
 
+mod demo;
 mod eval;
 mod export;
 mod info;
@@ -27,6 +28,7 @@ enum Command {
     Info(info::InfoArgs),
     Export(export::ExportArgs),
     Eval(eval::EvalArgs),
+    Demo(demo::DemoArgs),
     Plan(plan::PlanArgs),
     Stereo(stereo::StereoArgs),
 }
@@ -39,6 +41,7 @@ pub fn run() -> ExitCode {
         Command::Info(args) => info::run(args),
         Command::Export(args) => export::run(args),
         Command::Eval(args) => eval::run(args),
+        Command::Demo(args) => demo::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Stereo(args) => stereo::run(args),
     };

@@ -8,9 +8,11 @@
 //! centres to the true surface.
 
 mod experiment;
+mod figures;
 mod metrics;
 mod truth;
 
 pub use experiment::{ExperimentConfig, ExperimentReport, MapReport, run_experiment};
+pub use figures::top_down_png;
 pub use metrics::{MapMetrics, evaluate};
 pub use truth::{GroundTruth, gold_standard};
