@@ -48,3 +48,31 @@ fn gold_standard_matches_the_geometric_truth() {
         )
     );
 }
+
+#[test]
+fn the_wall_experiment_is_reproducible_and_reports_every_map() {
+    use fuzzyvox::eval::{ExperimentConfig, run_experiment};
+    use fuzzyvox::sim::scenario;
+    let scenario = scenario::wall().unwrap();
+    let config = ExperimentConfig {
+        resolution: 0.25,
+        operators: vec!["max".parse().unwrap()],
+        ..ExperimentConfig::default()
+    };
+    let (first, maps) = run_experiment(&scenario, &config).unwrap();
+    let (second, _) = run_experiment(&scenario, &config).unwrap();
+    let names: Vec<_> = first.maps.keys().cloned().collect();
+    assert_eq!(names, ["alpha", "fuzzy", "fuzzy:minimum", "logodds"]);
+    for name in &names {
+        assert_eq!(
+            first.maps[name].metrics, second.maps[name].metrics,
+            "{name}"
+        );
+        assert!(first.maps[name].phases.contains_key("strafe"));
+        assert!(first.maps[name].phases.contains_key("recede"));
+    }
+    assert_eq!(maps.len(), 4);
+    // The standard map built from the strafing pairs finds the wall.
+    assert!(first.maps["logodds"].metrics.occupied > 1000);
+    assert!(first.maps["logodds"].metrics.occupied_recall > 0.2);
+}
