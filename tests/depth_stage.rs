@@ -207,6 +207,19 @@ fn bad_inputs_are_typed_errors() {
         Frame::new(small.clone(), k, Isometry3::identity(), 0.0),
         Err(Error::SizeMismatch { .. })
     ));
+    // Tiny and odd images match without panicking (nothing to match in most of them).
+    for (w, h) in [(1u32, 1u32), (3, 2), (2, 9), (17, 1)] {
+        let tiny = GrayImage::new(w, h, (0..w * h).map(|i| (i * 7 % 5) as f32).collect()).unwrap();
+        let map = match_pair(&tiny, &tiny, &MatchParams::default()).unwrap();
+        assert_eq!(map.disparity.len(), (w * h) as usize);
+    }
+    let nan = GrayImage::new(4, 4, vec![f32::NAN; 16]).unwrap();
+    assert_eq!(
+        match_pair(&nan, &nan, &MatchParams::default())
+            .unwrap()
+            .density(),
+        0.0
+    );
     // Empty images.
     assert!(matches!(GrayImage::new(0, 0, vec![]), Err(Error::Empty(_))));
     assert!(matches!(GrayImage::new(4, 0, vec![]), Err(Error::Empty(_))));

@@ -57,10 +57,25 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
             let centre_row = rows[ry];
             // Interior pixels, whose window needs no clamping: one pass per neighbour over the
             // whole row, which the compiler vectorises.
-            let interior = rx..width.saturating_sub(rx).max(rx);
-            let centre = &centre_row[interior.clone()];
-            let codes = &mut out[interior.clone()];
-            for (r, row) in rows.iter().enumerate() {
+            let interior = if width > 2 * rx {
+                rx..width - rx
+            } else {
+                rx..rx
+            };
+            // (Images narrower than the window have no interior: `rx..rx` is empty and only the
+            // clamped loop below runs; the slices are then never taken.)
+            let interior_ok = !interior.is_empty();
+            let centre = if interior_ok {
+                &centre_row[interior.clone()]
+            } else {
+                &[][..]
+            };
+            let codes = if interior_ok {
+                &mut out[interior.clone()]
+            } else {
+                &mut [][..]
+            };
+            for (r, row) in rows.iter().enumerate().filter(|_| interior_ok) {
                 for k in (0..CENSUS_WIDTH).filter(|&k| sampled(k, r)) {
                     let neighbours = &row[interior.start + k - rx..interior.end + k - rx];
                     for ((code, &n), &c) in codes.iter_mut().zip(neighbours).zip(centre) {

@@ -12,6 +12,7 @@ mod metrics;
 mod pipeline;
 mod quality;
 mod rectify;
+mod scan;
 
 pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
