@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
 use super::gray::GrayImage;
-use super::scan::{INDEX, min_value, scan_column};
+use super::scan::{min_value, scan_column};
 use crate::error::{Error, Result};
 
 /// Largest supported aggregation window side; keeps window sums inside `i16`.
@@ -272,7 +272,6 @@ struct Scratch {
     costs: Vec<u8>,
     row: Vec<i16>,
     right_cost: Vec<i16>,
-    right_best: Vec<i16>,
     reversed: Vec<CensusCode>,
 }
 
@@ -285,7 +284,6 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
         costs: vec![0; plane],
         row: vec![0; plane],
         right_cost: vec![0; w],
-        right_best: vec![0; w],
         reversed: vec![0; w],
     };
     let mut ring = vec![0i16; rows * plane];
@@ -322,39 +320,23 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
 fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out: &mut [Cell]) {
     let (w, nd, dmin) = (ctx.width, ctx.disparities, ctx.min_disparity);
     let params = ctx.params;
-    // The right image's winners, for the left-right check: for right column xr, the best d
-    // over left columns x = xr + dmin + d, ties to the smallest d. Two passes in 16-bit lanes
-    // (the minimum cost, then the smallest disparity reaching it), stored mirrored (slot
-    // w - 1 - xr) so that increasing disparities walk increasing slots and both loops
-    // vectorise.
+    // The right image's best costs, for the left-right check: for right column xr, the least
+    // cost over left columns x = xr + dmin + d. Stored mirrored (slot w - 1 - xr) so that
+    // increasing disparities walk increasing slots and the loop vectorises.
     if params.left_right_tolerance.is_some() {
         scratch.right_cost.fill(i16::MAX);
-        scratch.right_best.fill(i16::MAX);
-        for pass in 0..2 {
-            for x in 0..w {
-                let (lo, hi) = valid_range(ctx, x);
-                if hi <= lo {
-                    continue;
-                }
-                let column = &sums[x * nd + lo..x * nd + hi];
-                let start = (w as isize - 1 - x as isize + dmin + lo as isize) as usize;
-                let slots = start..start + (hi - lo);
-                if pass == 0 {
-                    for (r, &c) in scratch.right_cost[slots].iter_mut().zip(column) {
-                        *r = (*r).min(c);
-                    }
-                } else {
-                    let costs = &scratch.right_cost[slots.clone()];
-                    let bests = &mut scratch.right_best[slots];
-                    for ((b, &m), (&c, &i)) in bests
-                        .iter_mut()
-                        .zip(costs)
-                        .zip(column.iter().zip(&INDEX[lo..]))
-                    {
-                        let mask = i16::from(c == m).wrapping_neg();
-                        *b = (*b).min((i & mask) | (i16::MAX & !mask));
-                    }
-                }
+        for x in 0..w {
+            let (lo, hi) = valid_range(ctx, x);
+            if hi <= lo {
+                continue;
+            }
+            let column = &sums[x * nd + lo..x * nd + hi];
+            let start = (w as isize - 1 - x as isize + dmin + lo as isize) as usize;
+            for (r, &c) in scratch.right_cost[start..start + (hi - lo)]
+                .iter_mut()
+                .zip(column)
+            {
+                *r = (*r).min(c);
             }
         }
     }
@@ -387,10 +369,24 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
         if !ctx.right.valid[y * w + xr] {
             continue;
         }
-        if let Some(tolerance) = params.left_right_tolerance
-            && u32::from(scratch.right_best[w - 1 - xr].abs_diff(best_d as i16)) > tolerance
-        {
-            continue;
+        // Left-right check: the right pixel's best match must lie within the tolerance of this
+        // one, i.e. one of the pairs (x + t, best_d + t), |t| <= tolerance, which all land on
+        // the same right pixel, must reach the right pixel's least cost. (Ties in the right
+        // image pass when any of the tied matches is close, which saves a second pass.)
+        if let Some(tolerance) = params.left_right_tolerance {
+            let target = scratch.right_cost[w - 1 - xr];
+            let reach = tolerance.min(ctx.disparities as u32) as isize;
+            let consistent = (-reach..=reach).any(|t| {
+                let (xx, dd) = (x as isize + t, best_d as isize + t);
+                xx >= 0
+                    && (xx as usize) < w
+                    && dd >= 0
+                    && (dd as usize) < nd
+                    && sums[xx as usize * nd + dd as usize] == target
+            });
+            if !consistent {
+                continue;
+            }
         }
         // Uniqueness: any disparity more than one pixel from the best under the bound.
         if let Some((first, last)) = scan.unique_span

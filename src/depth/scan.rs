@@ -7,7 +7,7 @@ use super::matching::MAX_DISPARITIES;
 
 /// `0, 1, 2, …` as `i16`: zipping with this instead of `enumerate` keeps index reductions in
 /// 16-bit lanes, so they vectorise eight or sixteen wide.
-pub(super) static INDEX: [i16; MAX_DISPARITIES as usize] = {
+static INDEX: [i16; MAX_DISPARITIES as usize] = {
     let mut index = [0i16; MAX_DISPARITIES as usize];
     let mut i = 0;
     while i < index.len() {
