@@ -147,6 +147,10 @@ struct Context<'a> {
     radius_x: usize,
     radius_y: usize,
     params: &'a MatchParams,
+    /// For every possible best cost `b`: the range threshold `b · (1 + tolerance)` and the
+    /// uniqueness bound `ceil(b · 100 / (100 - ratio))` (0 when the test is off; a rival costs
+    /// strictly less), so the per-pixel loop needs no division.
+    thresholds: Vec<(i16, i16)>,
 }
 
 /// Matches a rectified pair: `left(y, x)` corresponds to `right(y, x - d)`.
@@ -187,6 +191,7 @@ pub(crate) fn match_census(
         radius_x: params.window_width as usize / 2,
         radius_y: params.window_height as usize / 2,
         params,
+        thresholds: thresholds(params),
     };
     // The band split only decides which thread computes a row; every row's sums are exact, so
     // the output does not depend on it. Two bands per thread balance the load.
@@ -220,6 +225,24 @@ fn popcount8(v: u8) -> u8 {
     let v = v - ((v >> 1) & 0x55);
     let v = (v & 0x33) + ((v >> 2) & 0x33);
     (v + (v >> 4)) & 0x0f
+}
+
+/// The per-best-cost thresholds of [`Context`].
+fn thresholds(params: &MatchParams) -> Vec<(i16, i16)> {
+    let largest = params.window_width * params.window_height * u32::from(CENSUS_MAX_COST);
+    (0..=largest)
+        .map(|best| {
+            let range = (best as f32 * (1.0 + params.range_tolerance)).min(32766.0) as i16;
+            let unique = if params.uniqueness_ratio > 0 {
+                (best * 100)
+                    .div_ceil(100 - params.uniqueness_ratio)
+                    .min(i16::MAX as u32) as i16
+            } else {
+                0
+            };
+            (range, unique)
+        })
+        .collect()
 }
 
 /// Census Hamming costs of image row `row` for every pixel and disparity, `x` major.
@@ -410,17 +433,12 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
             continue;
         }
         let best_cost = min_value(column);
-        // Thresholds in cost units: within the range tolerance of the best, and below the
-        // uniqueness bound `best · 100 / (100 - ratio)` (a rival is a cost strictly under it).
-        let range_threshold =
-            (f32::from(best_cost) * (1.0 + params.range_tolerance)).min(32766.0) as i16;
-        let unique_bound = if params.uniqueness_ratio > 0 {
-            // best_cost >= 0: window sums of non-negative costs.
-            let bound = (best_cost as u32 * 100).div_ceil(100 - params.uniqueness_ratio);
-            bound.min(i16::MAX as u32) as i16
-        } else {
-            0
-        };
+        // Thresholds in cost units, looked up (see `Context::thresholds`).
+        let (range_threshold, unique_bound) = ctx
+            .thresholds
+            .get(best_cost.max(0) as usize)
+            .copied()
+            .unwrap_or((best_cost, 0));
         let scan = scan_column(column, best_cost, range_threshold, unique_bound);
         let best = scan.best;
         let best_d = lo + best;
