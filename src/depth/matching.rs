@@ -368,11 +368,11 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
         right_cost: vec![0; w],
         planes: std::array::from_fn(|_| vec![0; w]),
     };
-    let mut ring = vec![0i16; rows * plane];
+    let mut ring: Vec<Vec<i16>> = (0..rows).map(|_| vec![0i16; plane]).collect();
     let mut vertical = vec![0i16; plane];
     let first = y0 as isize - ctx.radius_y as isize;
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds logical row first + k (mod).
-    for (k, slot) in ring.chunks_exact_mut(plane).enumerate() {
+    for (k, slot) in ring.iter_mut().enumerate() {
         aggregated_row(ctx, first + k as isize, &mut scratch, slot);
         for (v, &s) in vertical.iter_mut().zip(slot.iter()) {
             *v = v.wrapping_add(s);
@@ -388,11 +388,14 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
             let slot_index = (leaving - first) as usize % rows;
             let mut entering = std::mem::take(&mut scratch.row);
             aggregated_row(ctx, leaving + rows as isize, &mut scratch, &mut entering);
-            let slot = &mut ring[slot_index * plane..(slot_index + 1) * plane];
-            for ((v, s), &e) in vertical.iter_mut().zip(slot.iter_mut()).zip(&entering) {
-                *v = v.wrapping_add(e).wrapping_sub(*s);
-                *s = e;
+            let Some(slot) = ring.get_mut(slot_index) else {
+                break;
+            };
+            for ((v, &s), &e) in vertical.iter_mut().zip(slot.iter()).zip(&entering) {
+                *v = v.wrapping_add(e).wrapping_sub(s);
             }
+            // The entering row takes the slot; the leaving one becomes the next scratch row.
+            std::mem::swap(slot, &mut entering);
             scratch.row = entering;
         }
     }
@@ -465,10 +468,10 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
                 continue;
             }
         }
-        // Uniqueness: any disparity more than one pixel from the best under the bound.
-        if let Some((first, last)) = scan.unique_span
-            && (first + 1 < best || last > best + 1)
-        {
+        // Uniqueness: any disparity more than one pixel from the best under the bound, i.e.
+        // more costs under it than the best and its two neighbours account for.
+        let near = &column[best.saturating_sub(1)..(best + 2).min(column.len())];
+        if scan.under_bound > near.iter().filter(|&&c| c < unique_bound).count() {
             continue;
         }
         // Cost-curve range: the span of all disparities within the tolerance of the best, so a

@@ -1,5 +1,5 @@
 //! Vectorised reductions over one pixel's column of window sums (the disparity axis): the best
-//! cost, its first index, the cost-curve range and the uniqueness span. Written as fixed-size
+//! cost, its first index, the cost-curve range and the count under the uniqueness bound. Written as fixed-size
 //! lane accumulators with branch-free selects, because `Iterator::min` and early-exit searches
 //! compile to one element at a time.
 
@@ -47,8 +47,7 @@ struct ScanLanes {
     best: [i16; SCAN_LANES],
     low: [i16; SCAN_LANES],
     high: [i16; SCAN_LANES],
-    unique_low: [i16; SCAN_LANES],
-    unique_high: [i16; SCAN_LANES],
+    under: [i16; SCAN_LANES],
 }
 
 impl ScanLanes {
@@ -57,8 +56,7 @@ impl ScanLanes {
             best: [NONE; SCAN_LANES],
             low: [NONE; SCAN_LANES],
             high: [-1; SCAN_LANES],
-            unique_low: [NONE; SCAN_LANES],
-            unique_high: [-1; SCAN_LANES],
+            under: [0; SCAN_LANES],
         }
     }
 
@@ -75,8 +73,7 @@ impl ScanLanes {
             self.best[k] = self.best[k].min((i & is_best) | (NONE & !is_best));
             self.low[k] = self.low[k].min((i & in_range) | (NONE & !in_range));
             self.high[k] = self.high[k].max((i & in_range) | !in_range);
-            self.unique_low[k] = self.unique_low[k].min((i & rival) | (NONE & !rival));
-            self.unique_high[k] = self.unique_high[k].max((i & rival) | !rival);
+            self.under[k] = self.under[k].wrapping_sub(rival);
         }
     }
 }
@@ -89,12 +86,12 @@ pub(super) struct ColumnScan {
     pub low: usize,
     /// Last index within the range threshold.
     pub high: usize,
-    /// First and last index strictly under the uniqueness bound, if any.
-    pub unique_span: Option<(usize, usize)>,
+    /// How many costs lie strictly under the uniqueness bound.
+    pub under_bound: usize,
 }
 
 /// Finds, in one vectorised pass, the first index of `best_cost`, the span of costs at most
-/// `range_threshold` and the span of costs under `unique_bound`. The selects are branch-free
+/// `range_threshold` and how many costs lie under `unique_bound`. The selects are branch-free
 /// (all-ones masks) so that the loop runs sixteen lanes at a time.
 #[inline]
 pub(super) fn scan_column(
@@ -126,19 +123,17 @@ pub(super) fn scan_column(
         best,
         low,
         high,
-        unique_low,
-        unique_high,
+        under,
     } = acc;
     let min = |a: &[i16; SCAN_LANES]| a.iter().copied().fold(NONE, i16::min);
     let max = |a: &[i16; SCAN_LANES]| a.iter().copied().fold(-1, i16::max);
     let best = min(&best).max(0) as usize;
-    let unique_span =
-        (max(&unique_high) >= 0).then(|| (min(&unique_low) as usize, max(&unique_high) as usize));
+    let under_bound = under.iter().map(|&n| n as usize).sum();
     ColumnScan {
         best,
         low: (min(&low) as usize).min(best),
         high: (max(&high).max(0) as usize).max(best),
-        unique_span,
+        under_bound,
     }
 }
 
@@ -166,9 +161,8 @@ mod tests {
                 scan.high,
                 column.iter().rposition(|&c| c <= best_cost + 5).unwrap()
             );
-            let first = column.iter().position(|&c| c < best_cost + 3).unwrap();
-            let last = column.iter().rposition(|&c| c < best_cost + 3).unwrap();
-            assert_eq!(scan.unique_span, Some((first, last)));
+            let under = column.iter().filter(|&&c| c < best_cost + 3).count();
+            assert_eq!(scan.under_bound, under);
         }
         assert_eq!(min_value(&[]), i16::MAX);
     }
