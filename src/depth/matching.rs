@@ -194,8 +194,9 @@ pub(crate) fn match_census(
         thresholds: thresholds(params),
     };
     // The band split only decides which thread computes a row; every row's sums are exact, so
-    // the output does not depend on it. Two bands per thread balance the load.
-    let bands = (rayon::current_num_threads() * 2).clamp(1, height);
+    // the output does not depend on it. One band per thread: each band
+    // re-aggregates the window's rows above it, so fewer bands do less work twice.
+    let bands = rayon::current_num_threads().clamp(1, height);
     let band_rows = height.div_ceil(bands);
     let mut cells = vec![NO_MATCH; width * height];
     cells
