@@ -3,7 +3,7 @@
 //! lane accumulators with branch-free selects, because `Iterator::min` and early-exit searches
 //! compile to one element at a time.
 
-use super::matching::MAX_DISPARITIES;
+use super::params::MAX_DISPARITIES;
 
 /// `0, 1, 2, …` as `i16`: zipping with this instead of `enumerate` keeps index reductions in
 /// 16-bit lanes, so they vectorise eight or sixteen wide.
