@@ -94,21 +94,31 @@ pub(crate) fn match_census(
     // re-aggregates the window's rows above it, so fewer bands do less work twice.
     let bands = rayon::current_num_threads().clamp(1, height);
     let band_rows = height.div_ceil(bands);
-    let mut cells = vec![NO_MATCH; width * height];
-    cells
+    let pixels = width * height;
+    let (mut disparity, mut range_low, mut range_high) =
+        (vec![0f32; pixels], vec![0f32; pixels], vec![0f32; pixels]);
+    // Each band fills its own rows of the three planes, so the split into planes runs in
+    // parallel too.
+    disparity
         .par_chunks_mut(band_rows * width)
+        .zip(range_low.par_chunks_mut(band_rows * width))
+        .zip(range_high.par_chunks_mut(band_rows * width))
         .enumerate()
-        .for_each(|(band, out)| {
+        .for_each(|(band, ((d, low), high))| {
             let y0 = band * band_rows;
             let y1 = (y0 + band_rows).min(height);
-            match_band(&ctx, y0, y1, out);
+            let mut cells = vec![NO_MATCH; d.len()];
+            match_band(&ctx, y0, y1, &mut cells);
+            for (((cell, d), low), high) in cells.iter().zip(d).zip(low).zip(high) {
+                (*d, *low, *high) = (cell.disparity, cell.low, cell.high);
+            }
         });
     DisparityMap {
         width: width as u32,
         height: height as u32,
-        disparity: cells.iter().map(|c| c.disparity).collect(),
-        range_low: cells.iter().map(|c| c.low).collect(),
-        range_high: cells.iter().map(|c| c.high).collect(),
+        disparity,
+        range_low,
+        range_high,
     }
 }
 
