@@ -107,11 +107,7 @@ pub(crate) fn match_census(
         .for_each(|(band, ((d, low), high))| {
             let y0 = band * band_rows;
             let y1 = (y0 + band_rows).min(height);
-            let mut cells = vec![NO_MATCH; d.len()];
-            match_band(&ctx, y0, y1, &mut cells);
-            for (((cell, d), low), high) in cells.iter().zip(d).zip(low).zip(high) {
-                (*d, *low, *high) = (cell.disparity, cell.low, cell.high);
-            }
+            match_band(&ctx, y0, y1, [d, low, high]);
         });
     DisparityMap {
         width: width as u32,
@@ -261,11 +257,14 @@ struct Scratch {
     costs: Vec<u8>,
     row: Vec<i16>,
     right_cost: Vec<i16>,
+    /// One row of results.
+    cells: Vec<Cell>,
     planes: [Vec<u8>; CODE_BYTES],
 }
 
 /// Matches rows `y0..y1` into `out` (those rows, row-major).
-fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
+/// `out` holds the band's rows of the disparity, range-low and range-high planes.
+fn match_band(ctx: &Context, y0: usize, y1: usize, mut out: [&mut [f32]; 3]) {
     let (w, nd) = (ctx.width, ctx.disparities);
     let plane = w * nd;
     let rows = 2 * ctx.radius_y + 1;
@@ -273,6 +272,7 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
         costs: vec![0; plane],
         row: vec![0; plane],
         right_cost: vec![0; w],
+        cells: vec![NO_MATCH; w],
         planes: std::array::from_fn(|_| vec![0; w]),
     };
     let mut ring: Vec<Vec<i16>> = (0..rows).map(|_| vec![0i16; plane]).collect();
@@ -286,8 +286,19 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
         }
     }
     for y in y0..y1 {
-        let out_row = &mut out[(y - y0) * w..(y - y0 + 1) * w];
-        select_row(ctx, y, &vertical, &mut scratch, out_row);
+        let mut cells = std::mem::take(&mut scratch.cells);
+        select_row(ctx, y, &vertical, &mut scratch, &mut cells);
+        let span = (y - y0) * w..(y - y0 + 1) * w;
+        let [d, low, high] = &mut out;
+        for (((cell, d), low), high) in cells
+            .iter()
+            .zip(&mut d[span.clone()])
+            .zip(&mut low[span.clone()])
+            .zip(&mut high[span])
+        {
+            (*d, *low, *high) = (cell.disparity, cell.low, cell.high);
+        }
+        scratch.cells = cells;
         if y + 1 < y1 {
             // Slide the window down one row: the row leaving shares its slot with the row
             // entering (they are `rows` apart).
