@@ -78,10 +78,15 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
     let pixels = image.pixels();
     let mut codes: Vec<CensusCode> = vec![0; width * height];
     let (rx, ry) = (CENSUS_WIDTH / 2, CENSUS_HEIGHT / 2);
+    let mut valid = vec![false; width * height];
     codes
         .par_chunks_mut(width)
+        .zip(valid.par_chunks_mut(width))
         .enumerate()
-        .for_each(|(y, out)| {
+        .for_each(|(y, (out, valid))| {
+            for (v, p) in valid.iter_mut().zip(&pixels[y * width..(y + 1) * width]) {
+                *v = !p.is_nan();
+            }
             // The clamped source rows of the window, top to bottom.
             let rows: [&[f32]; CENSUS_HEIGHT] = std::array::from_fn(|k| {
                 let yy = (y + k).saturating_sub(ry).min(height - 1);
@@ -119,7 +124,6 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
                 out[x] = bits;
             }
         });
-    let valid = pixels.iter().map(|p| !p.is_nan()).collect();
     CensusImage {
         width,
         height,
