@@ -1,7 +1,9 @@
 //! Matches the Middlebury motorcycle pair and prints accuracy and time (a development aid; the
 //! CLI's `fuzzyvox stereo` does the same with more options).
 //!
-//! Run: `cargo run --release --example stereo_eval -- ../shared/data/middlebury-motorcycle 80`
+//! Run: `cargo run --release --example stereo_eval -- DIR [NDISP WINDOW LR UNIQUENESS RUNS]`,
+//! e.g. `-- ../shared/data/middlebury-motorcycle 80 9 1 10 20` (the defaults; `LR` 0 turns the
+//! left-right check off).
 
 use std::path::PathBuf;
 

@@ -249,3 +249,71 @@ fn plan_through_a_saved_map() {
     assert!(String::from_utf8_lossy(&behind.stderr).contains("goal is not safe"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn stereo_reports_middlebury_accuracy_and_writes_maps() {
+    let Some(dir) = data_dir("stereo_reports_middlebury_accuracy_and_writes_maps") else {
+        return;
+    };
+    let folder = dir.join("middlebury-motorcycle");
+    let out = std::env::temp_dir().join(format!("fuzzyvox-stereo-{}", std::process::id()));
+    let report = json(&fuzzyvox(&[
+        "stereo",
+        "--middlebury",
+        folder.to_str().unwrap(),
+        "--ndisp",
+        "80",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["width"], 741);
+    assert_eq!(report["height"], 500);
+    assert_eq!(report["disparities"], 80);
+    assert!(report["seconds"].as_f64().unwrap() > 0.0);
+    assert!(report["bad2_all"].as_f64().unwrap() <= 18.0, "{report}");
+    assert!(
+        report["bad2_top50_confidence"].as_f64().unwrap() < 2.0,
+        "{report}"
+    );
+    assert!(report["density"].as_f64().unwrap() > 85.0, "{report}");
+    for name in ["disparity", "depth", "near", "far", "confidence"] {
+        let pfm = fuzzyvox::io::pfm::read_pfm(&out.join(format!("{name}.pfm"))).unwrap();
+        assert_eq!((pfm.width, pfm.height), (741, 500));
+        assert!(out.join(format!("{name}.png")).is_file());
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn stereo_rejects_bad_inputs_without_panicking() {
+    let missing = fuzzyvox(&["stereo", "--left", "a.png", "--right", "b.png"]);
+    assert_eq!(missing.status.code(), Some(2), "clap usage error");
+    let absent = fuzzyvox(&["stereo", "--middlebury", "/nonexistent/folder"]);
+    assert_eq!(absent.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&absent.stderr).contains("error"));
+    let Some(dir) = data_dir("stereo_rejects_bad_inputs_without_panicking") else {
+        return;
+    };
+    let folder = dir.join("middlebury-motorcycle");
+    let zero = fuzzyvox(&[
+        "stereo",
+        "--middlebury",
+        folder.to_str().unwrap(),
+        "--ndisp",
+        "0",
+    ]);
+    assert_eq!(zero.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&zero.stderr).contains("num_disparities"));
+    // Different image sizes: the right image is a depth PNG of another size.
+    let other = dir.join("rgbd-7scenes-redkitchen/frame-000150.color.png");
+    let sizes = fuzzyvox(&[
+        "stereo",
+        "--middlebury",
+        folder.to_str().unwrap(),
+        "--right",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(sizes.status.code(), Some(1));
+    assert!(!String::from_utf8_lossy(&sizes.stderr).contains("panicked"));
+}

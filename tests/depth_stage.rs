@@ -7,7 +7,10 @@ use fuzzyvox::depth::{
     DepthParams, Frame, GrayImage, IntervalMethod, MatchParams, PairCriteria, PairSelector,
     Rectification, Side, UnrectifiableReason, depth_from_pair, match_pair,
 };
-use fuzzyvox::{Error, PinholeIntrinsics};
+use fuzzyvox::io::pfm::read_pfm;
+use fuzzyvox::{
+    Error, FormatError, FuzzyConfig, FuzzyMap, IntegrationOptions, PinholeIntrinsics, VoxelMap,
+};
 use nalgebra::{Isometry3, Point2, Point3, Translation3, UnitQuaternion, Vector3};
 
 /// The textured plane `z = 4 + 0.3 x` (world), seen by cameras near the origin looking along +z.
@@ -113,6 +116,29 @@ fn synthetic_plane_depth_lies_in_the_interval() {
             100.0 * share
         );
         assert!(result.quality > 0.9, "strafe quality {}", result.quality);
+        eprintln!(
+            "{method:?}: {confident} confident pixels, {:.2}% contain the truth",
+            100.0 * share
+        );
+        // The output goes straight into a map.
+        let mut map = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+        let stats = map
+            .integrate_depth(frame, &IntegrationOptions::default())
+            .unwrap();
+        assert!(
+            stats.integrated > 0 && stats.voxels_updated > 0,
+            "{stats:?}"
+        );
+        // The centre pixel's P0 lands in a voxel with occupied evidence; halfway there is free.
+        let centre =
+            (rect.height() as usize / 2) * rect.width() as usize + rect.width() as usize / 2;
+        let z = f64::from(image.depth()[centre]);
+        let (u, v) = (f64::from(rect.width() / 2), f64::from(rect.height() / 2));
+        let at = |depth: f64| frame.world_from_camera() * rect.back_project(u, v, depth);
+        let surface = map.measures_at_point(&at(z)).unwrap();
+        let halfway = map.measures_at_point(&at(0.5 * z)).unwrap();
+        assert!(surface.occupied > 0.0, "{surface:?}");
+        assert!(halfway.free > 0.0 && halfway.occupied == 0.0, "{halfway:?}");
     }
 }
 
@@ -207,6 +233,19 @@ fn bad_inputs_are_typed_errors() {
         Frame::new(small.clone(), k, Isometry3::identity(), 0.0),
         Err(Error::SizeMismatch { .. })
     ));
+    // Tiny and odd images match without panicking (nothing to match in most of them).
+    for (w, h) in [(1u32, 1u32), (3, 2), (2, 9), (17, 1)] {
+        let tiny = GrayImage::new(w, h, (0..w * h).map(|i| (i * 7 % 5) as f32).collect()).unwrap();
+        let map = match_pair(&tiny, &tiny, &MatchParams::default()).unwrap();
+        assert_eq!(map.disparity.len(), (w * h) as usize);
+    }
+    let nan = GrayImage::new(4, 4, vec![f32::NAN; 16]).unwrap();
+    assert_eq!(
+        match_pair(&nan, &nan, &MatchParams::default())
+            .unwrap()
+            .density(),
+        0.0
+    );
     // Empty images.
     assert!(matches!(GrayImage::new(0, 0, vec![]), Err(Error::Empty(_))));
     assert!(matches!(GrayImage::new(4, 0, vec![]), Err(Error::Empty(_))));
@@ -287,4 +326,33 @@ fn bad_inputs_are_typed_errors() {
         Err(Error::InvalidParameter { .. })
     ));
     let _ = Point2::new(0.0, 0.0);
+}
+
+#[test]
+fn damaged_pfm_files_are_typed_errors() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-pfm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [(&str, &[u8]); 3] = [
+        ("truncated.pfm", b"Pf\n2 2\n-1.0\n\0\0\0\0\0\0"),
+        ("header.pfm", b"P5\n2 2\n255\n"),
+        ("huge.pfm", b"Pf\n99999999 99999999\n-1.0\n"),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        match read_pfm(&path) {
+            Err(Error::Format { reason, .. }) => {
+                assert!(matches!(
+                    reason,
+                    FormatError::Length { .. } | FormatError::BadMagic | FormatError::Invalid(_)
+                ));
+            }
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    assert!(matches!(
+        read_pfm(&dir.join("missing.pfm")),
+        Err(Error::Io { .. })
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

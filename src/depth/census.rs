@@ -37,6 +37,39 @@ pub struct CensusImage {
     pub valid: Vec<bool>,
 }
 
+/// Census strings of the interior columns `start..start + out.len()` of one row (no clamping
+/// needed there), built as four byte planes: each neighbour is one pass over the row whose
+/// comparisons fill sixteen byte lanes per instruction, then the planes are joined into `u32`
+/// strings. The bit order equals the clamped loop's: neighbour `i` of 31 at bit `30 - i`.
+fn interior_codes(
+    rows: &[&[f32]; CENSUS_HEIGHT],
+    centre: &[f32],
+    out: &mut [CensusCode],
+    start: usize,
+) {
+    let rx = CENSUS_WIDTH / 2;
+    let n = out.len();
+    // Neighbours in bit order, as (row, column offset) in the window.
+    let neighbours = (0..CENSUS_HEIGHT).flat_map(|r| {
+        (0..CENSUS_WIDTH)
+            .filter(move |&k| sampled(k, r))
+            .map(move |k| (r, k))
+    });
+    let mut planes = [vec![0u8; n], vec![0u8; n], vec![0u8; n], vec![0u8; n]];
+    for (i, (r, k)) in neighbours.enumerate() {
+        // Neighbour i lands in byte (30 - i) / 8 of the string, counted from the lowest.
+        let plane = &mut planes[3 - (30 - i) / 8];
+        let row = &rows[r][start + k - rx..start + k - rx + n];
+        for ((code, &v), &c) in plane.iter_mut().zip(row).zip(centre) {
+            *code = (*code << 1) | u8::from(v < c);
+        }
+    }
+    let [p0, p1, p2, p3] = &planes;
+    for ((((code, &a), &b), &c), &d) in out.iter_mut().zip(p0).zip(p1).zip(p2).zip(p3) {
+        *code = CensusCode::from_be_bytes([a, b, c, d]);
+    }
+}
+
 /// Computes the 9 × 7 census transform. Neighbours beyond the border repeat the border pixel
 /// (they then compare equal and give a 0 bit); `NaN` neighbours also give 0 bits.
 pub fn census_transform(image: &GrayImage) -> CensusImage {
@@ -45,10 +78,15 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
     let pixels = image.pixels();
     let mut codes: Vec<CensusCode> = vec![0; width * height];
     let (rx, ry) = (CENSUS_WIDTH / 2, CENSUS_HEIGHT / 2);
+    let mut valid = vec![false; width * height];
     codes
         .par_chunks_mut(width)
+        .zip(valid.par_chunks_mut(width))
         .enumerate()
-        .for_each(|(y, out)| {
+        .for_each(|(y, (out, valid))| {
+            for (v, p) in valid.iter_mut().zip(&pixels[y * width..(y + 1) * width]) {
+                *v = !p.is_nan();
+            }
             // The clamped source rows of the window, top to bottom.
             let rows: [&[f32]; CENSUS_HEIGHT] = std::array::from_fn(|k| {
                 let yy = (y + k).saturating_sub(ry).min(height - 1);
@@ -57,16 +95,21 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
             let centre_row = rows[ry];
             // Interior pixels, whose window needs no clamping: one pass per neighbour over the
             // whole row, which the compiler vectorises.
-            let interior = rx..width.saturating_sub(rx).max(rx);
-            let centre = &centre_row[interior.clone()];
-            let codes = &mut out[interior.clone()];
-            for (r, row) in rows.iter().enumerate() {
-                for k in (0..CENSUS_WIDTH).filter(|&k| sampled(k, r)) {
-                    let neighbours = &row[interior.start + k - rx..interior.end + k - rx];
-                    for ((code, &n), &c) in codes.iter_mut().zip(neighbours).zip(centre) {
-                        *code = (*code << 1) | CensusCode::from(n < c);
-                    }
-                }
+            let interior = if width > 2 * rx {
+                rx..width - rx
+            } else {
+                rx..rx
+            };
+            // (Images narrower than the window have no interior: `rx..rx` is empty and only the
+            // clamped loop below runs; the slices are then never taken.)
+            let interior_ok = !interior.is_empty();
+            let centre = if interior_ok {
+                &centre_row[interior.clone()]
+            } else {
+                &[][..]
+            };
+            if interior_ok {
+                interior_codes(&rows, centre, &mut out[interior.clone()], interior.start);
             }
             // Border columns, clamped.
             for x in (0..width).filter(|x| !interior.contains(x)) {
@@ -81,7 +124,6 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
                 out[x] = bits;
             }
         });
-    let valid = pixels.iter().map(|p| !p.is_nan()).collect();
     CensusImage {
         width,
         height,

@@ -8,7 +8,7 @@
 //!
 //! Confidence (paper eq. 10): `C = max(100 - a (P+ - P-), 0) · Q`, stored divided by 100.
 
-use super::matching::DisparityMap;
+use super::params::DisparityMap;
 use super::rectify::StereoGeometry;
 use crate::error::{Error, Result};
 use crate::integrate::IntervalDepthImage;
@@ -90,7 +90,21 @@ pub fn interval_image(
     quality: f64,
 ) -> Result<IntervalDepthImage> {
     params.validate()?;
-    let n = disparities.disparity.len();
+    let n = disparities.width as usize * disparities.height as usize;
+    // The map's fields are public, so check that its planes agree before indexing them.
+    for (what, plane) in [
+        ("disparity plane", &disparities.disparity),
+        ("range_low plane", &disparities.range_low),
+        ("range_high plane", &disparities.range_high),
+    ] {
+        if plane.len() != n {
+            return Err(Error::SizeMismatch {
+                what,
+                expected: n,
+                found: plane.len(),
+            });
+        }
+    }
     let mut near = vec![f32::NAN; n];
     let mut depth = vec![f32::NAN; n];
     let mut far = vec![f32::NAN; n];
@@ -130,4 +144,72 @@ pub fn interval_image(
         far,
         conf,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::PinholeIntrinsics;
+    use nalgebra::Isometry3;
+
+    fn geometry() -> StereoGeometry {
+        let k = PinholeIntrinsics::new(3, 1, 100.0, 100.0, 1.0, 0.0).unwrap();
+        StereoGeometry::new(k, Isometry3::identity(), 0.5, 0.0).unwrap()
+    }
+
+    fn map(d: [f32; 3], low: [f32; 3], high: [f32; 3]) -> DisparityMap {
+        DisparityMap {
+            width: 3,
+            height: 1,
+            disparity: d.to_vec(),
+            range_low: low.to_vec(),
+            range_high: high.to_vec(),
+        }
+    }
+
+    #[test]
+    fn fixed_and_curve_intervals_and_confidence() {
+        let g = geometry();
+        let m = map(
+            [10.0, 0.5, f32::NAN],
+            [8.0, 0.0, f32::NAN],
+            [12.0, 1.0, f32::NAN],
+        );
+        let fixed = IntervalParams {
+            method: IntervalMethod::FixedDelta { delta: 1.0 },
+            confidence_slope: 5.0,
+        };
+        let image = interval_image(&m, &g, &fixed, 0.8).unwrap();
+        // Z = 50 / d: P0 = 5, P- = 50/11, P+ = 50/9.
+        assert!((image.depth()[0] - 5.0).abs() < 1e-6);
+        assert!((image.near()[0] - 50.0 / 11.0).abs() < 1e-5);
+        assert!((image.far()[0] - 50.0 / 9.0).abs() < 1e-5);
+        let width = 50.0 / 9.0 - 50.0 / 11.0;
+        assert!(
+            (image.confidence()[0] - ((100.0 - 5.0 * width) * 0.8 / 100.0) as f32).abs() < 1e-6
+        );
+        // d - δ <= 0: P+ undefined, no confidence.
+        assert!(image.far()[1].is_nan() && image.confidence()[1] == 0.0);
+        assert!(image.depth()[2].is_nan());
+        let curve = IntervalParams::default();
+        let image = interval_image(&m, &g, &curve, 1.0).unwrap();
+        assert!((image.near()[0] - 50.0 / 13.0).abs() < 1e-5);
+        assert!((image.far()[0] - 50.0 / 7.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn inconsistent_maps_and_parameters_are_errors() {
+        let g = geometry();
+        let mut m = map([10.0; 3], [9.0; 3], [11.0; 3]);
+        m.range_low.pop();
+        assert!(matches!(
+            interval_image(&m, &g, &IntervalParams::default(), 1.0),
+            Err(Error::SizeMismatch { .. })
+        ));
+        let bad = IntervalParams {
+            method: IntervalMethod::CostCurve { delta: -1.0 },
+            confidence_slope: 5.0,
+        };
+        assert!(interval_image(&map([1.0; 3], [1.0; 3], [1.0; 3]), &g, &bad, 1.0).is_err());
+    }
 }

@@ -14,113 +14,10 @@ use rayon::prelude::*;
 
 use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
 use super::gray::GrayImage;
+use super::scan::{min_value, scan_column};
 use crate::error::{Error, Result};
 
-/// Largest supported aggregation window side; keeps window sums inside `i16`.
-pub const MAX_WINDOW: u32 = 15;
-/// Largest supported number of disparities.
-pub const MAX_DISPARITIES: u32 = 1024;
-
-/// Matching parameters.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MatchParams {
-    /// Smallest disparity searched (pixels); may be negative.
-    pub min_disparity: i32,
-    /// Number of disparities searched, `min_disparity .. min_disparity + num_disparities`.
-    pub num_disparities: u32,
-    /// Aggregation window width (odd, at most [`MAX_WINDOW`]).
-    pub window_width: u32,
-    /// Aggregation window height (odd, at most [`MAX_WINDOW`]).
-    pub window_height: u32,
-    /// Uniqueness margin in percent, as OpenCV's `uniquenessRatio`: a match is dropped when a
-    /// disparity more than one pixel away from the best costs less than
-    /// `best · 100 / (100 - ratio)`. 0 disables the test.
-    pub uniqueness_ratio: u32,
-    /// Left-right check: the right image's best match must come back to within this many
-    /// pixels; `None` disables the check.
-    pub left_right_tolerance: Option<u32>,
-    /// Relative tolerance of the cost-curve range: every disparity whose aggregated cost is at
-    /// most `best · (1 + tolerance)` lies in the range.
-    pub range_tolerance: f32,
-}
-
-impl Default for MatchParams {
-    fn default() -> Self {
-        Self {
-            min_disparity: 0,
-            num_disparities: 64,
-            window_width: 9,
-            window_height: 9,
-            uniqueness_ratio: 10,
-            left_right_tolerance: Some(1),
-            range_tolerance: 0.25,
-        }
-    }
-}
-
-impl MatchParams {
-    /// Checks the parameters.
-    pub fn validate(&self) -> Result<()> {
-        if self.num_disparities == 0 || self.num_disparities > MAX_DISPARITIES {
-            return Err(Error::InvalidParameter {
-                name: "num_disparities",
-                value: f64::from(self.num_disparities),
-                expected: "1 to 1024 disparities",
-            });
-        }
-        for (name, side) in [
-            ("window_width", self.window_width),
-            ("window_height", self.window_height),
-        ] {
-            if side % 2 == 0 || side > MAX_WINDOW {
-                return Err(Error::InvalidParameter {
-                    name,
-                    value: f64::from(side),
-                    expected: "an odd window side from 1 to 15",
-                });
-            }
-        }
-        if self.uniqueness_ratio >= 100 {
-            return Err(Error::InvalidParameter {
-                name: "uniqueness_ratio",
-                value: f64::from(self.uniqueness_ratio),
-                expected: "a percentage below 100",
-            });
-        }
-        if !(self.range_tolerance.is_finite() && self.range_tolerance >= 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "range_tolerance",
-                value: f64::from(self.range_tolerance),
-                expected: "a finite tolerance >= 0",
-            });
-        }
-        Ok(())
-    }
-}
-
-/// The matcher's result in the left (reference) image: per pixel the sub-pixel disparity and the
-/// cost-curve disparity range `[low, high]` around it, all `NaN` where no match survived.
-#[derive(Clone, Debug, PartialEq)]
-pub struct DisparityMap {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Sub-pixel disparity, row-major; `NaN` = no match.
-    pub disparity: Vec<f32>,
-    /// Lowest integer disparity whose cost is within the range tolerance of the best.
-    pub range_low: Vec<f32>,
-    /// Highest integer disparity whose cost is within the range tolerance of the best.
-    pub range_high: Vec<f32>,
-}
-
-impl DisparityMap {
-    /// Fraction of pixels with a disparity.
-    pub fn density(&self) -> f64 {
-        let matched = self.disparity.iter().filter(|d| !d.is_nan()).count();
-        matched as f64 / self.disparity.len().max(1) as f64
-    }
-}
+use super::params::{DisparityMap, MatchParams};
 
 #[derive(Clone, Copy)]
 struct Cell {
@@ -146,6 +43,10 @@ struct Context<'a> {
     radius_x: usize,
     radius_y: usize,
     params: &'a MatchParams,
+    /// For every possible best cost `b`: the range threshold `b · (1 + tolerance)` and the
+    /// uniqueness bound `ceil(b · 100 / (100 - ratio))` (0 when the test is off; a rival costs
+    /// strictly less), so the per-pixel loop needs no division.
+    thresholds: Vec<(i16, i16)>,
 }
 
 /// Matches a rectified pair: `left(y, x)` corresponds to `right(y, x - d)`.
@@ -186,50 +87,135 @@ pub(crate) fn match_census(
         radius_x: params.window_width as usize / 2,
         radius_y: params.window_height as usize / 2,
         params,
+        thresholds: thresholds(params),
     };
     // The band split only decides which thread computes a row; every row's sums are exact, so
-    // the output does not depend on it. Two bands per thread balance the load.
-    let bands = (rayon::current_num_threads() * 2).clamp(1, height);
+    // the output does not depend on it. One band per thread: each band
+    // re-aggregates the window's rows above it, so fewer bands do less work twice.
+    let bands = rayon::current_num_threads().clamp(1, height);
     let band_rows = height.div_ceil(bands);
-    let mut cells = vec![NO_MATCH; width * height];
-    cells
+    let pixels = width * height;
+    let (mut disparity, mut range_low, mut range_high) =
+        (vec![0f32; pixels], vec![0f32; pixels], vec![0f32; pixels]);
+    // Each band fills its own rows of the three planes, so the split into planes runs in
+    // parallel too.
+    disparity
         .par_chunks_mut(band_rows * width)
+        .zip(range_low.par_chunks_mut(band_rows * width))
+        .zip(range_high.par_chunks_mut(band_rows * width))
         .enumerate()
-        .for_each(|(band, out)| {
+        .for_each(|(band, ((d, low), high))| {
             let y0 = band * band_rows;
             let y1 = (y0 + band_rows).min(height);
-            match_band(&ctx, y0, y1, out);
+            match_band(&ctx, y0, y1, [d, low, high]);
         });
     DisparityMap {
         width: width as u32,
         height: height as u32,
-        disparity: cells.iter().map(|c| c.disparity).collect(),
-        range_low: cells.iter().map(|c| c.low).collect(),
-        range_high: cells.iter().map(|c| c.high).collect(),
+        disparity,
+        range_low,
+        range_high,
     }
 }
 
+/// Bytes of one census string.
+const CODE_BYTES: usize = std::mem::size_of::<CensusCode>();
+
+/// Population count of each byte, branch-free in byte lanes (SSE2 has no byte popcount, and a
+/// 32-bit `count_ones` vectorises four lanes wide with costly narrowing; this runs sixteen).
+#[inline(always)]
+fn popcount8(v: u8) -> u8 {
+    let v = v - ((v >> 1) & 0x55);
+    let v = (v & 0x33) + ((v >> 2) & 0x33);
+    (v + (v >> 4)) & 0x0f
+}
+
+/// The per-best-cost thresholds of [`Context`].
+fn thresholds(params: &MatchParams) -> Vec<(i16, i16)> {
+    let largest = params.window_width * params.window_height * u32::from(CENSUS_MAX_COST);
+    (0..=largest)
+        .map(|best| {
+            let range = (best as f32 * (1.0 + params.range_tolerance)).min(32766.0) as i16;
+            let unique = if params.uniqueness_ratio > 0 {
+                (best * 100)
+                    .div_ceil(100 - params.uniqueness_ratio)
+                    .min(i16::MAX as u32) as i16
+            } else {
+                0
+            };
+            (range, unique)
+        })
+        .collect()
+}
+
 /// Census Hamming costs of image row `row` for every pixel and disparity, `x` major.
-fn cost_row(ctx: &Context, row: usize, costs: &mut [u8], reversed: &mut [CensusCode]) {
+///
+/// The right row is split into byte planes, each reversed so that increasing disparities read
+/// increasing addresses; the distance is the sum of the four planes' byte popcounts, computed
+/// sixteen disparities at a time.
+fn cost_row(ctx: &Context, row: usize, costs: &mut [u8], planes: &mut [Vec<u8>; CODE_BYTES]) {
+    const CHUNK: usize = 16;
     let (w, nd) = (ctx.width, ctx.disparities);
     let left = &ctx.left.codes[row * w..(row + 1) * w];
-    // The right row reversed, so that increasing disparities read increasing addresses and the
-    // XOR-popcount loop vectorises.
     let right = &ctx.right.codes[row * w..(row + 1) * w];
-    for (r, &code) in reversed.iter_mut().zip(right.iter().rev()) {
-        *r = code;
+    for (p, plane) in planes.iter_mut().enumerate() {
+        for (r, &code) in plane.iter_mut().zip(right.iter().rev()) {
+            *r = (code >> (8 * p)) as u8;
+        }
     }
+    let [p0, p1, p2, p3] = planes;
     for (x, (&code, out)) in left.iter().zip(costs.chunks_exact_mut(nd)).enumerate() {
         let (lo, hi) = valid_range(ctx, x);
-        out[..lo].fill(CENSUS_MAX_COST);
-        out[hi..].fill(CENSUS_MAX_COST);
-        if hi > lo {
-            // Right column x - dmin - d sits at reversed index w - 1 - x + dmin + d.
-            let start = (w as isize - 1 - x as isize + ctx.min_disparity + lo as isize) as usize;
-            let right = &reversed[start..start + (hi - lo)];
-            for (c, &r) in out[lo..hi].iter_mut().zip(right) {
-                *c = (code ^ r).count_ones() as u8;
+        if lo > 0 {
+            out[..lo].fill(CENSUS_MAX_COST);
+        }
+        if hi < nd {
+            out[hi.max(lo)..].fill(CENSUS_MAX_COST);
+        }
+        if hi <= lo {
+            continue;
+        }
+        let [b0, b1, b2, b3] = code.to_le_bytes();
+        // Right column x - dmin - d sits at reversed index w - 1 - x + dmin + d.
+        let start = (w as isize - 1 - x as isize + ctx.min_disparity + lo as isize) as usize;
+        let len = hi - lo;
+        let (r0, r1, r2, r3) = (
+            &p0[start..start + len],
+            &p1[start..start + len],
+            &p2[start..start + len],
+            &p3[start..start + len],
+        );
+        let out = &mut out[lo..hi];
+        let cost = |k: usize| {
+            popcount8(b0 ^ r0[k])
+                + popcount8(b1 ^ r1[k])
+                + popcount8(b2 ^ r2[k])
+                + popcount8(b3 ^ r3[k])
+        };
+        let full = len - len % CHUNK;
+        for base in (0..full).step_by(CHUNK) {
+            let block: &mut [u8; CHUNK] = match (&mut out[base..base + CHUNK]).try_into() {
+                Ok(block) => block,
+                Err(_) => continue,
+            };
+            let (q0, q1, q2, q3): (&[u8; CHUNK], &[u8; CHUNK], &[u8; CHUNK], &[u8; CHUNK]) = match (
+                r0[base..base + CHUNK].try_into(),
+                r1[base..base + CHUNK].try_into(),
+                r2[base..base + CHUNK].try_into(),
+                r3[base..base + CHUNK].try_into(),
+            ) {
+                (Ok(a), Ok(b), Ok(c), Ok(d)) => (a, b, c, d),
+                _ => continue,
+            };
+            for k in 0..CHUNK {
+                block[k] = popcount8(b0 ^ q0[k])
+                    + popcount8(b1 ^ q1[k])
+                    + popcount8(b2 ^ q2[k])
+                    + popcount8(b3 ^ q3[k]);
             }
+        }
+        for (k, c) in out.iter_mut().enumerate().skip(full) {
+            *c = cost(k);
         }
     }
 }
@@ -263,7 +249,7 @@ fn horizontal_sums(ctx: &Context, costs: &[u8], sums: &mut [i16]) {
 /// Horizontally aggregated costs of image row `row` (clamped to the image).
 fn aggregated_row(ctx: &Context, row: isize, scratch: &mut Scratch, out: &mut [i16]) {
     let row = row.clamp(0, ctx.height as isize - 1) as usize;
-    cost_row(ctx, row, &mut scratch.costs, &mut scratch.reversed);
+    cost_row(ctx, row, &mut scratch.costs, &mut scratch.planes);
     horizontal_sums(ctx, &scratch.costs, out);
 }
 
@@ -271,12 +257,14 @@ struct Scratch {
     costs: Vec<u8>,
     row: Vec<i16>,
     right_cost: Vec<i16>,
-    right_best: Vec<i16>,
-    reversed: Vec<CensusCode>,
+    /// One row of results.
+    cells: Vec<Cell>,
+    planes: [Vec<u8>; CODE_BYTES],
 }
 
 /// Matches rows `y0..y1` into `out` (those rows, row-major).
-fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
+/// `out` holds the band's rows of the disparity, range-low and range-high planes.
+fn match_band(ctx: &Context, y0: usize, y1: usize, mut out: [&mut [f32]; 3]) {
     let (w, nd) = (ctx.width, ctx.disparities);
     let plane = w * nd;
     let rows = 2 * ctx.radius_y + 1;
@@ -284,22 +272,33 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
         costs: vec![0; plane],
         row: vec![0; plane],
         right_cost: vec![0; w],
-        right_best: vec![0; w],
-        reversed: vec![0; w],
+        cells: vec![NO_MATCH; w],
+        planes: std::array::from_fn(|_| vec![0; w]),
     };
-    let mut ring = vec![0i16; rows * plane];
+    let mut ring: Vec<Vec<i16>> = (0..rows).map(|_| vec![0i16; plane]).collect();
     let mut vertical = vec![0i16; plane];
     let first = y0 as isize - ctx.radius_y as isize;
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds logical row first + k (mod).
-    for (k, slot) in ring.chunks_exact_mut(plane).enumerate() {
+    for (k, slot) in ring.iter_mut().enumerate() {
         aggregated_row(ctx, first + k as isize, &mut scratch, slot);
         for (v, &s) in vertical.iter_mut().zip(slot.iter()) {
             *v = v.wrapping_add(s);
         }
     }
     for y in y0..y1 {
-        let out_row = &mut out[(y - y0) * w..(y - y0 + 1) * w];
-        select_row(ctx, y, &vertical, &mut scratch, out_row);
+        let mut cells = std::mem::take(&mut scratch.cells);
+        select_row(ctx, y, &vertical, &mut scratch, &mut cells);
+        let span = (y - y0) * w..(y - y0 + 1) * w;
+        let [d, low, high] = &mut out;
+        for (((cell, d), low), high) in cells
+            .iter()
+            .zip(&mut d[span.clone()])
+            .zip(&mut low[span.clone()])
+            .zip(&mut high[span])
+        {
+            (*d, *low, *high) = (cell.disparity, cell.low, cell.high);
+        }
+        scratch.cells = cells;
         if y + 1 < y1 {
             // Slide the window down one row: the row leaving shares its slot with the row
             // entering (they are `rows` apart).
@@ -307,11 +306,14 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
             let slot_index = (leaving - first) as usize % rows;
             let mut entering = std::mem::take(&mut scratch.row);
             aggregated_row(ctx, leaving + rows as isize, &mut scratch, &mut entering);
-            let slot = &mut ring[slot_index * plane..(slot_index + 1) * plane];
-            for ((v, s), &e) in vertical.iter_mut().zip(slot.iter_mut()).zip(&entering) {
-                *v = v.wrapping_add(e).wrapping_sub(*s);
-                *s = e;
+            let Some(slot) = ring.get_mut(slot_index) else {
+                break;
+            };
+            for ((v, &s), &e) in vertical.iter_mut().zip(slot.iter()).zip(&entering) {
+                *v = v.wrapping_add(e).wrapping_sub(s);
             }
+            // The entering row takes the slot; the leaving one becomes the next scratch row.
+            std::mem::swap(slot, &mut entering);
             scratch.row = entering;
         }
     }
@@ -321,39 +323,23 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: &mut [Cell]) {
 fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out: &mut [Cell]) {
     let (w, nd, dmin) = (ctx.width, ctx.disparities, ctx.min_disparity);
     let params = ctx.params;
-    // The right image's winners, for the left-right check: for right column xr, the best d
-    // over left columns x = xr + dmin + d, ties to the smallest d. Two passes in 16-bit lanes
-    // (the minimum cost, then the smallest disparity reaching it), stored mirrored (slot
-    // w - 1 - xr) so that increasing disparities walk increasing slots and both loops
-    // vectorise.
+    // The right image's best costs, for the left-right check: for right column xr, the least
+    // cost over left columns x = xr + dmin + d. Stored mirrored (slot w - 1 - xr) so that
+    // increasing disparities walk increasing slots and the loop vectorises.
     if params.left_right_tolerance.is_some() {
         scratch.right_cost.fill(i16::MAX);
-        scratch.right_best.fill(i16::MAX);
-        for pass in 0..2 {
-            for x in 0..w {
-                let (lo, hi) = valid_range(ctx, x);
-                if hi <= lo {
-                    continue;
-                }
-                let column = &sums[x * nd + lo..x * nd + hi];
-                let start = (w as isize - 1 - x as isize + dmin + lo as isize) as usize;
-                let slots = start..start + (hi - lo);
-                if pass == 0 {
-                    for (r, &c) in scratch.right_cost[slots].iter_mut().zip(column) {
-                        *r = (*r).min(c);
-                    }
-                } else {
-                    let costs = &scratch.right_cost[slots.clone()];
-                    let bests = &mut scratch.right_best[slots];
-                    for ((b, &m), (&c, &i)) in bests
-                        .iter_mut()
-                        .zip(costs)
-                        .zip(column.iter().zip(&INDEX[lo..]))
-                    {
-                        let mask = i16::from(c == m).wrapping_neg();
-                        *b = (*b).min((i & mask) | (i16::MAX & !mask));
-                    }
-                }
+        for x in 0..w {
+            let (lo, hi) = valid_range(ctx, x);
+            if hi <= lo {
+                continue;
+            }
+            let column = &sums[x * nd + lo..x * nd + hi];
+            let start = (w as isize - 1 - x as isize + dmin + lo as isize) as usize;
+            for (r, &c) in scratch.right_cost[start..start + (hi - lo)]
+                .iter_mut()
+                .zip(column)
+            {
+                *r = (*r).min(c);
             }
         }
     }
@@ -368,17 +354,12 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
             continue;
         }
         let best_cost = min_value(column);
-        // Thresholds in cost units: within the range tolerance of the best, and below the
-        // uniqueness bound `best · 100 / (100 - ratio)` (a rival is a cost strictly under it).
-        let range_threshold =
-            (f32::from(best_cost) * (1.0 + params.range_tolerance)).min(32766.0) as i16;
-        let unique_bound = if params.uniqueness_ratio > 0 {
-            // best_cost >= 0: window sums of non-negative costs.
-            let bound = (best_cost as u32 * 100).div_ceil(100 - params.uniqueness_ratio);
-            bound.min(i16::MAX as u32) as i16
-        } else {
-            0
-        };
+        // Thresholds in cost units, looked up (see `Context::thresholds`).
+        let (range_threshold, unique_bound) = ctx
+            .thresholds
+            .get(best_cost.max(0) as usize)
+            .copied()
+            .unwrap_or((best_cost, 0));
         let scan = scan_column(column, best_cost, range_threshold, unique_bound);
         let best = scan.best;
         let best_d = lo + best;
@@ -386,15 +367,29 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
         if !ctx.right.valid[y * w + xr] {
             continue;
         }
-        if let Some(tolerance) = params.left_right_tolerance
-            && u32::from(scratch.right_best[w - 1 - xr].abs_diff(best_d as i16)) > tolerance
-        {
-            continue;
+        // Left-right check: the right pixel's best match must lie within the tolerance of this
+        // one, i.e. one of the pairs (x + t, best_d + t), |t| <= tolerance, which all land on
+        // the same right pixel, must reach the right pixel's least cost. (Ties in the right
+        // image pass when any of the tied matches is close, which saves a second pass.)
+        if let Some(tolerance) = params.left_right_tolerance {
+            let target = scratch.right_cost[w - 1 - xr];
+            let reach = tolerance.min(ctx.disparities as u32) as isize;
+            let consistent = (-reach..=reach).any(|t| {
+                let (xx, dd) = (x as isize + t, best_d as isize + t);
+                xx >= 0
+                    && (xx as usize) < w
+                    && dd >= 0
+                    && (dd as usize) < nd
+                    && sums[xx as usize * nd + dd as usize] == target
+            });
+            if !consistent {
+                continue;
+            }
         }
-        // Uniqueness: any disparity more than one pixel from the best under the bound.
-        if let Some((first, last)) = scan.unique_span
-            && (first + 1 < best || last > best + 1)
-        {
+        // Uniqueness: any disparity more than one pixel from the best under the bound, i.e.
+        // more costs under it than the best and its two neighbours account for.
+        let near = &column[best.saturating_sub(1)..(best + 2).min(column.len())];
+        if scan.under_bound > near.iter().filter(|&&c| c < unique_bound).count() {
             continue;
         }
         // Cost-curve range: the span of all disparities within the tolerance of the best, so a
@@ -420,143 +415,6 @@ fn select_row(ctx: &Context, y: usize, sums: &[i16], scratch: &mut Scratch, out:
             low: base + low as f32,
             high: base + high as f32,
         };
-    }
-}
-
-/// `0, 1, 2, …` as `i16`: zipping with this instead of `enumerate` keeps index reductions in
-/// 16-bit lanes, so they vectorise eight or sixteen wide.
-static INDEX: [i16; MAX_DISPARITIES as usize] = {
-    let mut index = [0i16; MAX_DISPARITIES as usize];
-    let mut i = 0;
-    while i < index.len() {
-        index[i] = i as i16;
-        i += 1;
-    }
-    index
-};
-
-/// Lanes of the explicit reductions below: fixed-size accumulator arrays that the compiler maps
-/// to SIMD registers (an `Iterator::min` folds one element at a time).
-const LANES: usize = 16;
-
-/// The smallest value (`i16::MAX` for an empty slice).
-#[inline]
-fn min_value(values: &[i16]) -> i16 {
-    let mut acc = [i16::MAX; LANES];
-    let chunks = values.chunks_exact(LANES);
-    let rest = chunks.remainder();
-    for chunk in chunks {
-        for k in 0..LANES {
-            acc[k] = acc[k].min(chunk[k]);
-        }
-    }
-    acc.iter().chain(rest).copied().fold(i16::MAX, i16::min)
-}
-
-/// Lanes of [`scan_column`]: one SSE register of `i16` per accumulator, so its five
-/// accumulators stay in registers.
-const SCAN_LANES: usize = 8;
-
-/// "No index" in the lane accumulators below.
-const NONE: i16 = i16::MAX;
-
-/// Lane accumulators of [`scan_column`].
-struct ScanLanes {
-    best: [i16; SCAN_LANES],
-    low: [i16; SCAN_LANES],
-    high: [i16; SCAN_LANES],
-    unique_low: [i16; SCAN_LANES],
-    unique_high: [i16; SCAN_LANES],
-}
-
-impl ScanLanes {
-    fn new() -> Self {
-        Self {
-            best: [NONE; SCAN_LANES],
-            low: [NONE; SCAN_LANES],
-            high: [-1; SCAN_LANES],
-            unique_low: [NONE; SCAN_LANES],
-            unique_high: [-1; SCAN_LANES],
-        }
-    }
-
-    /// One chunk; `(best_cost, range_threshold, unique_bound)`. Padding lanes carry the cost
-    /// `i16::MAX`, which no threshold accepts (thresholds are clamped below it or equal to the
-    /// best cost, itself far below it).
-    #[inline(always)]
-    fn step(&mut self, c: &[i16; SCAN_LANES], index: &[i16; SCAN_LANES], t: (i16, i16, i16)) {
-        for k in 0..SCAN_LANES {
-            let (c, i) = (c[k], index[k]);
-            let is_best = i16::from(c == t.0).wrapping_neg();
-            let in_range = i16::from(c <= t.1).wrapping_neg();
-            let rival = i16::from(c < t.2).wrapping_neg();
-            self.best[k] = self.best[k].min((i & is_best) | (NONE & !is_best));
-            self.low[k] = self.low[k].min((i & in_range) | (NONE & !in_range));
-            self.high[k] = self.high[k].max((i & in_range) | !in_range);
-            self.unique_low[k] = self.unique_low[k].min((i & rival) | (NONE & !rival));
-            self.unique_high[k] = self.unique_high[k].max((i & rival) | !rival);
-        }
-    }
-}
-
-/// What one pass over a pixel's cost column finds.
-struct ColumnScan {
-    /// First index of the best cost.
-    best: usize,
-    /// First index within the range threshold.
-    low: usize,
-    /// Last index within the range threshold.
-    high: usize,
-    /// First and last index strictly under the uniqueness bound, if any.
-    unique_span: Option<(usize, usize)>,
-}
-
-/// Finds, in one vectorised pass, the first index of `best_cost`, the span of costs at most
-/// `range_threshold` and the span of costs under `unique_bound`. The selects are branch-free
-/// (all-ones masks) so that the loop runs sixteen lanes at a time.
-#[inline]
-fn scan_column(
-    column: &[i16],
-    best_cost: i16,
-    range_threshold: i16,
-    unique_bound: i16,
-) -> ColumnScan {
-    let mut acc = ScanLanes::new();
-    let chunks = column.chunks_exact(SCAN_LANES);
-    let rest = chunks.remainder();
-    let thresholds = (best_cost, range_threshold, unique_bound);
-    for (chunk, index) in chunks.zip(INDEX.chunks_exact(SCAN_LANES)) {
-        // Fixed-size copies: the compiler then knows the trip count and vectorises.
-        let chunk: &[i16; SCAN_LANES] = chunk.try_into().unwrap_or(&[NONE; SCAN_LANES]);
-        let index: &[i16; SCAN_LANES] = index.try_into().unwrap_or(&[NONE; SCAN_LANES]);
-        acc.step(chunk, index, thresholds);
-    }
-    if !rest.is_empty() {
-        // Pad the tail with a cost that no threshold accepts.
-        let mut chunk = [NONE; SCAN_LANES];
-        chunk[..rest.len()].copy_from_slice(rest);
-        let tail = column.len() - rest.len();
-        let mut index = [NONE; SCAN_LANES];
-        index[..rest.len()].copy_from_slice(&INDEX[tail..tail + rest.len()]);
-        acc.step(&chunk, &index, thresholds);
-    }
-    let ScanLanes {
-        best,
-        low,
-        high,
-        unique_low,
-        unique_high,
-    } = acc;
-    let min = |a: &[i16; SCAN_LANES]| a.iter().copied().fold(NONE, i16::min);
-    let max = |a: &[i16; SCAN_LANES]| a.iter().copied().fold(-1, i16::max);
-    let best = min(&best).max(0) as usize;
-    let unique_span =
-        (max(&unique_high) >= 0).then(|| (min(&unique_low) as usize, max(&unique_high) as usize));
-    ColumnScan {
-        best,
-        low: (min(&low) as usize).min(best),
-        high: (max(&high).max(0) as usize).max(best),
-        unique_span,
     }
 }
 

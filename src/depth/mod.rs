@@ -9,9 +9,11 @@ mod gray;
 mod interval;
 mod matching;
 mod metrics;
+mod params;
 mod pipeline;
 mod quality;
 mod rectify;
+mod scan;
 
 pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
@@ -20,8 +22,9 @@ pub use census::{
 pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
 pub use gray::GrayImage;
 pub use interval::{IntervalMethod, IntervalParams, confidence, interval_image};
-pub use matching::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams, match_pair};
+pub use matching::match_pair;
 pub use metrics::{Accuracy, evaluate};
+pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
 pub use pipeline::{
     DepthParams, DepthResult, depth_from_pair, depth_from_rectified, depth_from_selected,
 };

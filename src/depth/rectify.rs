@@ -126,7 +126,7 @@ impl StereoGeometry {
             (-self.doffs).floor()
         };
         let count = high - low + 1.0;
-        if !(count >= 1.0 && count <= f64::from(super::matching::MAX_DISPARITIES)) {
+        if !(count >= 1.0 && count <= f64::from(super::params::MAX_DISPARITIES)) {
             return Err(Error::InvalidParameter {
                 name: "disparity count for the depth range",
                 value: count,
