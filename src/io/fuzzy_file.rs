@@ -1,8 +1,5 @@
-use std::path::Path;
-
 use serde::{Deserialize, Serialize};
 
-use super::atomic::write_atomic;
 use super::mapfile::{self, MapKind};
 use super::stored_blocks::{self, StoredBlock};
 use crate::error::{FormatError, Result};
@@ -14,6 +11,8 @@ struct Body {
     config: FuzzyConfig,
     blocks: Vec<StoredBlock<Memberships>>,
 }
+
+mapfile::native_file_methods!(FuzzyMap);
 
 impl FuzzyMap {
     /// The map as the bytes of a native map file. Blocks are written in key order, so equal
@@ -29,24 +28,6 @@ impl FuzzyMap {
                 blocks: stored_blocks::store(self.grid()),
             },
         )
-    }
-
-    /// Reads a map from the bytes of a native map file, checking the header, the length, the
-    /// checksum and every value.
-    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
-        mapfile::from_memory(bytes, Self::decode)
-    }
-
-    /// Saves the map to `path` atomically (temporary file, sync, rename): a crash never leaves
-    /// a half-written map, and a failed save leaves the old file intact.
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
-        write_atomic(path.as_ref(), &self.to_bytes())
-    }
-
-    /// Loads a map saved by [`FuzzyMap::save`]. A damaged, truncated or foreign file is a
-    /// typed [`Error::Format`](crate::Error::Format).
-    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        mapfile::load_with(path.as_ref(), Self::decode)
     }
 
     fn decode(bytes: &[u8]) -> Result<Self, FormatError> {

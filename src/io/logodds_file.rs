@@ -1,8 +1,5 @@
-use std::path::Path;
-
 use serde::{Deserialize, Serialize};
 
-use super::atomic::write_atomic;
 use super::mapfile::{self, MapKind};
 use super::stored_blocks::{self, StoredBlock};
 use crate::error::{FormatError, Result};
@@ -34,6 +31,8 @@ fn decode_body<Config: serde::de::DeserializeOwned>(
     Ok((body.config, grid))
 }
 
+mapfile::native_file_methods!(LogOddsMap);
+
 impl LogOddsMap {
     /// The map as the bytes of a native map file (blocks in key order).
     pub fn to_bytes(&self) -> Vec<u8> {
@@ -49,21 +48,6 @@ impl LogOddsMap {
         )
     }
 
-    /// Reads a map from the bytes of a native map file.
-    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
-        mapfile::from_memory(bytes, Self::decode)
-    }
-
-    /// Saves the map atomically (temporary file, sync, rename).
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
-        write_atomic(path.as_ref(), &self.to_bytes())
-    }
-
-    /// Loads a map saved by [`LogOddsMap::save`].
-    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        mapfile::load_with(path.as_ref(), Self::decode)
-    }
-
     fn decode(bytes: &[u8]) -> Result<Self, FormatError> {
         let (config, grid) = decode_body(bytes, MapKind::LogOdds, |c: &LogOddsConfig| {
             c.resolution.size()
@@ -74,6 +58,8 @@ impl LogOddsMap {
         Ok(LogOddsMap::from_parts(config, grid))
     }
 }
+
+mapfile::native_file_methods!(AlphaCutMap);
 
 impl AlphaCutMap {
     /// The map as the bytes of a native map file (blocks in key order).
@@ -88,21 +74,6 @@ impl AlphaCutMap {
                 blocks: stored_blocks::store(self.log_odds().grid()),
             },
         )
-    }
-
-    /// Reads a map from the bytes of a native map file.
-    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
-        mapfile::from_memory(bytes, Self::decode)
-    }
-
-    /// Saves the map atomically (temporary file, sync, rename).
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
-        write_atomic(path.as_ref(), &self.to_bytes())
-    }
-
-    /// Loads a map saved by [`AlphaCutMap::save`].
-    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        mapfile::load_with(path.as_ref(), Self::decode)
     }
 
     fn decode(bytes: &[u8]) -> Result<Self, FormatError> {

@@ -176,6 +176,33 @@ pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
     ))
 }
 
+/// The file methods every map has, given its `to_bytes` and `decode`: `from_bytes`, an atomic
+/// `save` and a checked `load`.
+macro_rules! native_file_methods {
+    ($map:ty) => {
+        impl $map {
+            /// Reads a map from the bytes of a native map file, checking the header, the
+            /// length, the checksum and every value.
+            pub fn from_bytes(bytes: &[u8]) -> crate::error::Result<Self> {
+                super::mapfile::from_memory(bytes, Self::decode)
+            }
+
+            /// Saves the map atomically (temporary file, sync, rename): a crash never leaves a
+            /// half-written map, and a failed save leaves the old file intact.
+            pub fn save(&self, path: impl AsRef<std::path::Path>) -> crate::error::Result<()> {
+                super::atomic::write_atomic(path.as_ref(), &self.to_bytes())
+            }
+
+            /// Loads a map saved by `save`. A damaged, truncated or foreign file is a typed
+            /// [`Error::Format`](crate::Error::Format).
+            pub fn load(path: impl AsRef<std::path::Path>) -> crate::error::Result<Self> {
+                super::mapfile::load_with(path.as_ref(), Self::decode)
+            }
+        }
+    };
+}
+pub(crate) use native_file_methods;
+
 /// Reads a map file and decodes it with `decode`, naming the file in any error.
 pub(crate) fn load_with<T>(
     path: &Path,
