@@ -97,7 +97,6 @@ fn path_goes_through_the_door_and_keeps_the_vehicle_radius() {
 #[test]
 fn petgraph_astar_runs_on_the_implicit_graph_and_agrees() {
     let room = room(true);
-    let r = room.resolution();
     let region = PlanningRegion::new(VoxelKey::new(0, 0, 5), VoxelKey::new(99, 59, 15)).unwrap();
     let field = CostField::build(&room, region, config()).unwrap();
     let (start, goal) = (VoxelKey::new(20, 10, 10), VoxelKey::new(80, 50, 10));
@@ -119,7 +118,6 @@ fn petgraph_astar_runs_on_the_implicit_graph_and_agrees() {
     );
     assert_eq!(graph.key(nodes[0]), start);
     assert_eq!(graph.key(*nodes.last().unwrap()), goal);
-    let _ = r;
 }
 
 #[test]

@@ -5,7 +5,7 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use fuzzyvox::eval::{ExperimentConfig, ExperimentReport, run_experiment, top_down_png};
-use fuzzyvox::io::octomap::write_bt;
+use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::sim::scenario::{self, Scenario};
 
 /// The simulated flight demo: a drone's camera maps the paper's two scenes (a wall, then a
@@ -52,16 +52,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         for (name, map) in &maps {
             let stem = format!("{}-{}", scenario.name, name.replace(':', "_"));
             map.save(args.out.join(format!("{stem}.fvx")))?;
-            let voxels = map
-                .as_map()
-                .cells()
-                .map(|(key, m)| (key, m.occupied >= m.free))
-                .collect::<Vec<_>>();
-            write_bt(
-                &args.out.join(format!("{stem}.bt")),
-                map.as_map().resolution().size(),
-                voxels,
-            )?;
+            write_bt_max_likelihood(&args.out.join(format!("{stem}.bt")), map.as_map())?;
             top_down_png(
                 map.as_map(),
                 extent.0,

@@ -3,7 +3,7 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::Args;
 use fuzzyvox::AnyMap;
-use fuzzyvox::io::octomap::write_bt;
+use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use serde_json::json;
 
 /// Export a saved map to other tools' formats.
@@ -32,18 +32,7 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
         bail!("nothing to export: give --bt OUT.bt");
     };
     let map = AnyMap::load(&args.map)?;
-    let view = map.as_map();
-    let (mut occupied, mut free) = (0usize, 0usize);
-    let voxels: Vec<_> = view
-        .cells()
-        .map(|(key, m)| {
-            let is_occupied = m.occupied >= m.free;
-            occupied += usize::from(is_occupied);
-            free += usize::from(!is_occupied);
-            (key, is_occupied)
-        })
-        .collect();
-    write_bt(bt, view.resolution().size(), voxels)
+    let (occupied, free) = write_bt_max_likelihood(bt, map.as_map())
         .with_context(|| format!("writing {}", bt.display()))?;
     if args.json {
         return super::print_json(&json!({

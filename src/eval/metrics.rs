@@ -83,8 +83,8 @@ fn ratio(part: usize, whole: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::map::FunctionMap;
-    use crate::measures::Memberships;
+    use crate::integrate::{Evidence, ScanEvidence};
+    use crate::map::{FuzzyConfig, FuzzyMap};
     use crate::sim::SurfaceKind;
     use crate::storage::{Resolution, VoxelKey};
     use nalgebra::{Point3, Vector3};
@@ -109,38 +109,22 @@ mod tests {
         );
         // The map: three of the four wall voxels occupied, one free (a hole), and one
         // occupied voxel behind the wall (x = 7: unknown region, 1.5 m from the surface).
-        let occupied = Memberships {
-            occupied: 0.9,
-            free: 0.0,
-        };
-        let free = Memberships {
+        let mut evidence = ScanEvidence::new();
+        for key in &wall[1..] {
+            *evidence.cell_or_insert(*key) = Evidence {
+                occupied: 0.9,
+                free: 0.0,
+            };
+        }
+        *evidence.cell_or_insert(wall[0]) = Evidence {
             occupied: 0.0,
             free: 0.9,
         };
-        let map = FunctionMap::new(r, move |k: VoxelKey| match (k.x, k.y, k.z) {
-            (5, 0, 0) => free,
-            (5, 0..2, 0..2) => occupied,
-            (7, 0, 0) => occupied,
-            _ => Memberships::default(),
-        });
-        // A function map lists no cells, so evaluate a stored copy of it.
-        let mut stored =
-            crate::map::FuzzyMap::new(crate::map::FuzzyConfig::new(1.0).unwrap()).unwrap();
-        let mut evidence = crate::integrate::ScanEvidence::new();
-        for x in 0..8 {
-            for y in 0..2 {
-                for z in 0..2 {
-                    let m = map.memberships_at(VoxelKey::new(x, y, z));
-                    if m.occupied > 0.0 || m.free > 0.0 {
-                        *evidence.cell_or_insert(VoxelKey::new(x, y, z)) =
-                            crate::integrate::Evidence {
-                                occupied: m.occupied,
-                                free: m.free,
-                            };
-                    }
-                }
-            }
-        }
+        *evidence.cell_or_insert(VoxelKey::new(7, 0, 0)) = Evidence {
+            occupied: 0.9,
+            free: 0.0,
+        };
+        let mut stored = FuzzyMap::new(FuzzyConfig::new(1.0).unwrap()).unwrap();
         stored.apply_evidence(&evidence);
         let m = evaluate(&stored, &truth, &scene);
         assert_eq!(m.occupied, 4);

@@ -37,8 +37,7 @@ impl GroundTruth {
 
     /// Ground truth from a scene and its gold-standard map: the observed region is every voxel
     /// the gold standard observed, and the truly occupied voxels are the observed ones that meet
-    /// the scene geometry (the geometric truth) together with the gold standard's occupied
-    /// voxels that do.
+    /// the scene geometry (the geometric truth).
     pub fn from_scene(scene: &Scene, gold: &dyn VoxelMap) -> Self {
         let resolution = gold.resolution();
         let observed: Vec<VoxelKey> = gold.cells().map(|(key, _)| key).collect();

@@ -1,4 +1,3 @@
-use nalgebra::Point3;
 use rayon::prelude::*;
 
 use super::VoxelMap;
@@ -9,7 +8,7 @@ use crate::integrate::{
     DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
     cloud_evidence, depth_evidence,
 };
-use crate::measures::{MeasureConfig, Measures, Memberships, VoxelClass};
+use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::ops::TConorm;
 use crate::storage::{BlockGrid, KeyBox, Resolution, VoxelKey};
 
@@ -126,21 +125,6 @@ impl FuzzyMap {
             }
             updated
         })
-    }
-
-    /// A voxel's memberships at a world point.
-    pub fn memberships_at_point(&self, point: &Point3<f64>) -> Result<Memberships> {
-        Ok(self.memberships_at(self.config.resolution.key_of(point)?))
-    }
-
-    /// Every measure at a world point.
-    pub fn measures_at_point(&self, point: &Point3<f64>) -> Result<Measures> {
-        Ok(self.measures_at(self.config.resolution.key_of(point)?))
-    }
-
-    /// The class at a world point.
-    pub fn class_at_point(&self, point: &Point3<f64>) -> Result<VoxelClass> {
-        Ok(self.class_at(self.config.resolution.key_of(point)?))
     }
 
     /// Voxel counts per class over the allocated blocks, from the block summaries.

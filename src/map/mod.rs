@@ -16,6 +16,8 @@ pub use function::FunctionMap;
 pub use fuzzy::FuzzyMap;
 pub use logodds::{LogOdds, LogOddsConfig, LogOddsMap};
 
+use nalgebra::Point3;
+
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud};
 use crate::measures::{MeasureConfig, Measures, Memberships, VoxelClass};
@@ -56,6 +58,21 @@ pub trait VoxelMap: Send + Sync {
     /// Every observed voxel (one that some evidence reached) with its memberships, in storage
     /// order.
     fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_>;
+
+    /// A voxel's memberships at a world point (an error outside the key range).
+    fn memberships_at_point(&self, point: &Point3<f64>) -> Result<Memberships> {
+        Ok(self.memberships_at(self.resolution().key_of(point)?))
+    }
+
+    /// Every measure at a world point.
+    fn measures_at_point(&self, point: &Point3<f64>) -> Result<Measures> {
+        Ok(self.measures_at(self.resolution().key_of(point)?))
+    }
+
+    /// The class at a world point.
+    fn class_at_point(&self, point: &Point3<f64>) -> Result<VoxelClass> {
+        Ok(self.class_at(self.resolution().key_of(point)?))
+    }
 
     /// Every measure of a voxel.
     fn measures_at(&self, key: VoxelKey) -> Measures {

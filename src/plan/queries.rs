@@ -3,7 +3,7 @@ use nalgebra::Point3;
 use super::config::{PlannerConfig, UnknownPolicy};
 use crate::error::Result;
 use crate::map::VoxelMap;
-use crate::measures::{Measures, VoxelClass};
+use crate::measures::VoxelClass;
 use crate::storage::{KeyBox, VoxelKey};
 
 /// Questions a planner asks of any map, answered with one [`PlannerConfig`].
@@ -11,9 +11,6 @@ use crate::storage::{KeyBox, VoxelKey};
 /// A voxel is *safe* when it is free with safety at or above the threshold, or unknown while
 /// unknown space is allowed at a cost.
 pub trait SafetyQueries {
-    /// Every measure at a world point.
-    fn measures_at_point(&self, point: &Point3<f64>) -> Result<Measures>;
-
     /// Whether one voxel is safe under `config`.
     fn is_safe_voxel(&self, key: VoxelKey, config: &PlannerConfig) -> bool;
 
@@ -34,10 +31,6 @@ pub trait SafetyQueries {
 }
 
 impl<M: VoxelMap + ?Sized> SafetyQueries for M {
-    fn measures_at_point(&self, point: &Point3<f64>) -> Result<Measures> {
-        Ok(self.measures_at(self.resolution().key_of(point)?))
-    }
-
     fn is_safe_voxel(&self, key: VoxelKey, config: &PlannerConfig) -> bool {
         let m = self.measures_at(key);
         match m.class {

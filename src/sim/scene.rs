@@ -157,8 +157,7 @@ impl Scene {
         direction: &Vector3<f64>,
         max_distance: f64,
     ) -> Option<Hit> {
-        let dir = direction.try_normalize(1e-12)?;
-        let ray = Ray::new(origin.cast::<f32>(), dir.cast::<f32>());
+        let ray = single_precision_ray(origin, direction)?;
         let (index, _) = self.bvh.cast_ray(&ray, max_distance as f32, |leaf, best| {
             let object = self.objects.get(leaf as usize)?;
             object.shape.cast_ray(&object.pose, &ray, best, true)
@@ -174,8 +173,7 @@ impl Scene {
         direction: &Vector3<f64>,
         max_distance: f64,
     ) -> Option<Hit> {
-        let dir = direction.try_normalize(1e-12)?;
-        let ray = Ray::new(origin.cast::<f32>(), dir.cast::<f32>());
+        let ray = single_precision_ray(origin, direction)?;
         let mut best: Option<(usize, f32)> = None;
         for (i, object) in self.objects.iter().enumerate() {
             let limit = best.map_or(max_distance as f32, |b| b.1);
@@ -228,6 +226,12 @@ impl Scene {
             .map(|o| f64::from(o.shape.distance_to_point(&o.pose, &p, true)))
             .fold(f64::INFINITY, f64::min)
     }
+}
+
+/// parry's ray (single precision, unit direction); `None` for a zero direction.
+fn single_precision_ray(origin: &Point3<f64>, direction: &Vector3<f64>) -> Option<Ray> {
+    let dir = direction.try_normalize(1e-12)?;
+    Some(Ray::new(origin.cast::<f32>(), dir.cast::<f32>()))
 }
 
 #[cfg(test)]

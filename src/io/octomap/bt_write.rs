@@ -151,6 +151,24 @@ fn build(codes: &[u64], depth: u8, out: &mut Vec<u8>, nodes: &mut usize) -> Buil
     Built::Inner
 }
 
+/// Writes any map as an OctoMap `.bt` maximum-likelihood tree: every observed voxel is occupied
+/// when its occupied membership is at least its free membership (for a log-odds map `p ≥ 0.5`,
+/// OctoMap's own rule) and free otherwise; voxels nothing observed stay unknown. Returns the
+/// numbers of occupied and free voxels written.
+pub fn write_bt_max_likelihood(
+    path: &std::path::Path,
+    map: &dyn crate::map::VoxelMap,
+) -> Result<(usize, usize)> {
+    let voxels: Vec<_> = map
+        .cells()
+        .map(|(key, m)| (key, m.occupied >= m.free))
+        .collect();
+    let occupied = voxels.iter().filter(|(_, o)| *o).count();
+    let free = voxels.len() - occupied;
+    write_bt(path, map.resolution().size(), voxels)?;
+    Ok((occupied, free))
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::bt::decode_bt;
