@@ -4,8 +4,9 @@
 mod common;
 
 use fuzzyvox::depth::{
-    DepthParams, Frame, GrayImage, IntervalMethod, MatchParams, PairCriteria, PairSelector,
-    Rectification, Side, UnrectifiableReason, depth_from_pair, match_pair,
+    DepthParams, ForwardMotion, Frame, GrayImage, IntervalMethod, MatchMethod, MatchParams,
+    PairCriteria, PairSelector, Rectification, Side, UnrectifiableReason, depth_by_plane_sweep,
+    depth_from_pair, match_pair,
 };
 use fuzzyvox::io::pfm::read_pfm;
 use fuzzyvox::{
@@ -59,6 +60,90 @@ fn pose(position: [f64; 3], yaw_degrees: f64) -> Isometry3<f64> {
         Translation3::new(position[0], position[1], position[2]),
         UnitQuaternion::from_euler_angles(0.02, yaw_degrees.to_radians(), 0.01),
     )
+}
+
+#[test]
+fn forward_motion_is_matched_by_plane_sweep_with_honest_intervals() {
+    let k = camera();
+    let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
+    // Half a metre back along the view: the epipole sits near the image centre.
+    let other_pose = pose([0.01, 0.0, -0.5], 0.0);
+    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 0.0).unwrap();
+    let other = Frame::new(render(&k, &other_pose), k, other_pose, 0.5).unwrap();
+    let mut params = DepthParams {
+        depth_range: Some((2.0, 12.0)),
+        ..DepthParams::default()
+    };
+    assert!(matches!(
+        depth_from_pair(&reference, &other, &params),
+        Err(Error::Unrectifiable {
+            reason: UnrectifiableReason::EpipoleInImage { .. }
+        })
+    ));
+    params.forward_motion = ForwardMotion::PlaneSweep;
+    let result = depth_from_pair(&reference, &other, &params).unwrap();
+    assert_eq!(result.method, MatchMethod::PlaneSweep);
+    assert!(result.quality < 0.1, "Q_ABD = {}", result.quality);
+    // The output lives in the original reference camera.
+    assert_eq!(result.frame.world_from_camera(), &reference_pose);
+    let image = result.frame.image();
+    let origin = Point3::origin();
+    let (mut bounded, mut inside) = (0usize, 0usize);
+    // Interval widths near the epipole (centre) and near the image border.
+    let (mut centre, mut border) = (Vec::new(), Vec::new());
+    for i in 0..image.depth().len() {
+        let (near, depth, far) = (image.near()[i], image.depth()[i], image.far()[i]);
+        if !depth.is_finite() {
+            continue;
+        }
+        assert!(near <= depth, "P- > P0 at {i}");
+        if !far.is_finite() {
+            continue;
+        }
+        assert!(depth <= far, "P0 > P+ at {i}");
+        let (u, v) = ((i % 320) as f64, (i / 320) as f64);
+        let ray = reference_pose.rotation * k.back_project(u, v, 1.0).coords;
+        let truth = (reference_pose.inverse() * plane_hit(&origin, &ray).unwrap()).z as f32;
+        bounded += 1;
+        inside += usize::from(near <= truth && truth <= far);
+        let radius = ((u - 159.5).powi(2) + (v - 119.5).powi(2)).sqrt();
+        if radius < 30.0 {
+            centre.push(far - near);
+        } else if radius > 120.0 {
+            border.push(far - near);
+        }
+    }
+    assert!(bounded > 320 * 240 / 4, "{bounded} pixels with an interval");
+    let share = inside as f64 / bounded as f64;
+    assert!(share > 0.9, "truth inside the interval for {share:.3}");
+    let median = |v: &mut Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f32::INFINITY)
+    };
+    // Near the epipole the image barely moves: wider intervals (or none at all).
+    assert!(median(&mut border) < median(&mut centre) || centre.is_empty());
+    // Confidence carries the pair's poor geometry.
+    assert!(
+        image
+            .confidence()
+            .iter()
+            .all(|c| c.is_nan() || *c <= result.quality as f32 + 1e-6)
+    );
+    // The sweep works for a sideways pair too, and needs a depth range.
+    let sideways = Frame::new(
+        render(&k, &pose([0.35, 0.0, 0.0], 0.0)),
+        k,
+        pose([0.35, 0.0, 0.0], 0.0),
+        1.0,
+    )
+    .unwrap();
+    let swept = depth_by_plane_sweep(&reference, &sideways, 1.0, &params).unwrap();
+    assert!(swept.frame.image().valid_pixels() > 320 * 240 / 2);
+    params.depth_range = None;
+    assert!(matches!(
+        depth_by_plane_sweep(&reference, &sideways, 1.0, &params),
+        Err(Error::InvalidParameter { .. })
+    ));
 }
 
 #[test]

@@ -250,11 +250,23 @@ fn frustum_frees_space_in_front_occupies_the_wall_and_leaves_behind_unknown() {
     let frame = wall_frame(Point3::new(0.0, 0.0, 0.5), 3.0);
     let stats = map.integrate_depth(&frame, &Default::default()).unwrap();
     assert!(stats.integrated > 3000 && stats.skipped > 0);
-    // One frame of a ±5 % interval spreads its occupied evidence thin: some, but not yet
-    // enough for the occupied class.
+    // One frame marks the voxels holding its most likely points with a full hit, and spreads
+    // thin evidence over the rest of its ±5 % interval (in front of the wall, before P0).
     let wall = Point3::new(3.05, 0.05, 0.55);
     let once = map.memberships_at_point(&wall).unwrap();
-    assert!(once.occupied > 0.1 && once.occupied < 0.3, "{once:?}");
+    // k_O = 0.7 at confidence 0.9 under the probabilistic sum: 1 - 0.3^0.9.
+    assert!(
+        (once.occupied - (1.0 - 0.3f32.powf(0.9))).abs() < 1e-5,
+        "{once:?}"
+    );
+    let before = map
+        .memberships_at_point(&Point3::new(2.95, 0.05, 0.55))
+        .unwrap();
+    assert!(
+        before.occupied > 0.05 && before.occupied < 0.3,
+        "{before:?}"
+    );
+    assert_eq!(before.free, 0.0);
     for _ in 0..3 {
         map.integrate_depth(&frame, &Default::default()).unwrap();
     }

@@ -68,11 +68,23 @@ fn the_wall_experiment_is_reproducible_and_reports_every_map() {
             first.maps[name].metrics, second.maps[name].metrics,
             "{name}"
         );
-        assert!(first.maps[name].phases.contains_key("strafe"));
-        assert!(first.maps[name].phases.contains_key("recede"));
+        assert_eq!(
+            first.maps[name].after.keys().collect::<Vec<_>>(),
+            ["after_strafe"]
+        );
     }
     assert_eq!(maps.len(), 4);
     // The standard map built from the strafing pairs finds the wall.
     assert!(first.maps["logodds"].metrics.occupied > 1000);
     assert!(first.maps["logodds"].metrics.occupied_recall > 0.2);
+    // The receding pairs (matched by plane sweep) erode the standard map's wall and put voxels
+    // behind it; the confidence-aware maps barely change.
+    assert_eq!(first.swept_pairs, 6);
+    let standard = &first.maps["logodds"];
+    let strafed = &standard.after["after_strafe"];
+    assert!(standard.metrics.holes > 2 * strafed.holes);
+    assert!(standard.metrics.spurious_unknown > 2 * strafed.spurious_unknown);
+    let fuzzy = &first.maps["fuzzy"].metrics;
+    assert!(5 * fuzzy.holes <= standard.metrics.holes);
+    assert!(5 * fuzzy.spurious_unknown <= standard.metrics.spurious_unknown);
 }

@@ -14,6 +14,7 @@ mod pipeline;
 mod quality;
 mod rectify;
 mod scan;
+mod sweep;
 
 pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
@@ -26,7 +27,8 @@ pub use matching::match_pair;
 pub use metrics::{Accuracy, evaluate};
 pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
 pub use pipeline::{
-    DepthParams, DepthResult, depth_from_pair, depth_from_rectified, depth_from_selected,
+    DepthParams, DepthResult, ForwardMotion, MatchMethod, depth_by_plane_sweep, depth_from_pair,
+    depth_from_rectified, depth_from_selected,
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
 pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry, UnrectifiableReason};

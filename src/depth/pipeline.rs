@@ -1,5 +1,5 @@
 //! From a pair of posed frames (or an already rectified pair) to a [`DepthFrame`] of intervals
-//! and confidence in the rectified reference camera, ready for `integrate_depth`.
+//! and confidence in the (rectified) reference camera, ready for `integrate_depth`.
 
 use std::time::Instant;
 
@@ -9,8 +9,9 @@ use super::interval::{IntervalParams, interval_image};
 use super::matching::match_pair;
 use super::params::{DisparityMap, MatchParams};
 use super::quality::extrinsic_quality;
-use super::rectify::{Rectification, Side, StereoGeometry};
-use crate::error::Result;
+use super::rectify::{Rectification, Side, StereoGeometry, UnrectifiableReason};
+use super::sweep::{Sweep, sweep_pair};
+use crate::error::{Error, Result};
 use crate::integrate::DepthFrame;
 
 /// Settings of the whole depth stage.
@@ -21,8 +22,33 @@ pub struct DepthParams {
     /// Interval and confidence settings.
     pub interval: IntervalParams,
     /// Depths to search, `(near, far)` in metres (`far` may be infinite); sets the disparity
-    /// range from the pair's geometry.
+    /// range from the pair's geometry. The plane sweep needs it.
     pub depth_range: Option<(f64, f64)>,
+    /// What [`depth_from_pair`] does with a pair whose epipole lies inside an image.
+    pub forward_motion: ForwardMotion,
+}
+
+/// What to do with a pair that rectification refuses because one camera's centre projects
+/// inside the other's image (motion along the look direction).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ForwardMotion {
+    /// Refuse it with [`UnrectifiableReason::EpipoleInImage`].
+    #[default]
+    Reject,
+    /// Match it by plane sweep in the original reference camera (see `docs/depth.md`): depth
+    /// comes out where the image moves enough, with wide intervals near the epipole, and the
+    /// confidence carries the pair's low `Q_ABD`. This is how the wall scenario's receding
+    /// pairs reach the maps.
+    PlaneSweep,
+}
+
+/// How a pair was matched.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MatchMethod {
+    /// Rectified and matched along rows.
+    Rectified,
+    /// Plane sweep in the original reference camera.
+    PlaneSweep,
 }
 
 /// The depth stage's output for one pair.
@@ -30,10 +56,12 @@ pub struct DepthParams {
 pub struct DepthResult {
     /// Interval depth and confidence in the rectified reference camera.
     pub frame: DepthFrame,
-    /// The disparities behind it.
+    /// The disparities behind it (for a plane sweep: fractional plane indices).
     pub disparity: DisparityMap,
-    /// The rectified pair's geometry.
+    /// The geometry that turns those disparities into depth in the frame's camera.
     pub geometry: StereoGeometry,
+    /// How the pair was matched.
+    pub method: MatchMethod,
     /// The pair's `Q_ABD`.
     pub quality: f64,
     /// Wall time of the matching step (census, costs, aggregation, checks), in seconds.
@@ -58,6 +86,25 @@ pub fn depth_from_rectified(
     let start = Instant::now();
     let disparity = match_pair(left, right, &matching)?;
     let matching_seconds = start.elapsed().as_secs_f64();
+    finish(
+        disparity,
+        geometry,
+        quality,
+        params,
+        matching_seconds,
+        MatchMethod::Rectified,
+    )
+}
+
+/// Intervals and confidence from a disparity map.
+fn finish(
+    disparity: DisparityMap,
+    geometry: &StereoGeometry,
+    quality: f64,
+    params: &DepthParams,
+    matching_seconds: f64,
+    method: MatchMethod,
+) -> Result<DepthResult> {
     let image = interval_image(&disparity, geometry, &params.interval, quality)?;
     let frame = DepthFrame::new(
         *geometry.reference(),
@@ -68,31 +115,73 @@ pub fn depth_from_rectified(
         frame,
         disparity,
         geometry: geometry.clone(),
+        method,
         quality,
         matching_seconds,
     })
 }
 
 /// Depth from two posed frames: `Q_ABD`, rectification, matching and intervals. The output is in
-/// the rectified `reference` camera (same centre, rotated so the baseline is its x axis).
+/// the rectified `reference` camera (same centre, rotated so the baseline is its x axis), or,
+/// for a forward-motion pair with [`ForwardMotion::PlaneSweep`], in the original reference
+/// camera.
 ///
-/// Errors: invalid poses, pairs that cannot be rectified (zero baseline, epipole inside an
-/// image, opposite views), invalid parameters.
+/// Errors: invalid poses, pairs that cannot be rectified (zero baseline, opposite views, and an
+/// epipole inside an image unless the plane sweep is chosen), invalid parameters.
 pub fn depth_from_pair(
     reference: &Frame,
     other: &Frame,
     params: &DepthParams,
 ) -> Result<DepthResult> {
     let quality = extrinsic_quality(reference.world_from_camera(), other.world_from_camera())?;
-    let rectification = Rectification::new(
+    let rectification = match Rectification::new(
         reference.intrinsics(),
         reference.world_from_camera(),
         other.intrinsics(),
         other.world_from_camera(),
-    )?;
+    ) {
+        Err(Error::Unrectifiable {
+            reason: UnrectifiableReason::EpipoleInImage { .. },
+        }) if params.forward_motion == ForwardMotion::PlaneSweep => {
+            return depth_by_plane_sweep(reference, other, quality.q, params);
+        }
+        other => other?,
+    };
     let left = rectification.warp(Side::Reference, reference.image())?;
     let right = rectification.warp(Side::Other, other.image())?;
     depth_from_rectified(&left, &right, rectification.geometry(), quality.q, params)
+}
+
+/// Depth from two posed frames by plane sweep in the original reference camera, whatever their
+/// geometry (any baseline direction; see [`ForwardMotion::PlaneSweep`]). `params.depth_range`
+/// is required; `quality` is the pair's `Q_ABD`.
+pub fn depth_by_plane_sweep(
+    reference: &Frame,
+    other: &Frame,
+    quality: f64,
+    params: &DepthParams,
+) -> Result<DepthResult> {
+    params.interval.validate()?;
+    let Some((near, far)) = params.depth_range else {
+        return Err(Error::InvalidParameter {
+            name: "depth_range",
+            value: f64::NAN,
+            expected: "a depth range (near, far) for the plane sweep",
+        });
+    };
+    let sweep = Sweep::new(reference, other, near, far)?;
+    let geometry = sweep.geometry(reference)?;
+    let start = Instant::now();
+    let disparity = sweep_pair(reference, other, &sweep, &params.matching)?;
+    let matching_seconds = start.elapsed().as_secs_f64();
+    finish(
+        disparity,
+        &geometry,
+        quality,
+        params,
+        matching_seconds,
+        MatchMethod::PlaneSweep,
+    )
 }
 
 /// Depth from a pair chosen by a [`PairSelector`](super::PairSelector).

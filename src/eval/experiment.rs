@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
-use crate::depth::{DepthParams, Frame, GrayImage, depth_from_pair};
+use crate::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, depth_from_pair};
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions};
 use crate::map::{
@@ -26,7 +26,9 @@ pub struct ExperimentConfig {
     pub resolution: f64,
     /// Extra fuzzy maps, one per operator (the default fuzzy map uses the probabilistic sum).
     pub operators: Vec<Family>,
-    /// The depth stage's settings (its depth range defaults to 1 m .. the scenario's range).
+    /// The depth stage's settings (its depth range defaults to 1 m .. the scenario's range;
+    /// forward-motion pairs go through the plane sweep by default, as the paper feeds every
+    /// pair to the maps).
     pub depth: DepthParams,
     /// Seed of the sensor noise.
     pub seed: u64,
@@ -37,7 +39,10 @@ impl Default for ExperimentConfig {
         Self {
             resolution: 0.2,
             operators: Vec::new(),
-            depth: DepthParams::default(),
+            depth: DepthParams {
+                forward_motion: ForwardMotion::PlaneSweep,
+                ..DepthParams::default()
+            },
             seed: 1,
         }
     }
@@ -49,8 +54,9 @@ pub struct MapReport {
     /// At the end of the flight.
     #[serde(flatten)]
     pub metrics: MapMetrics,
-    /// After each phase, by name.
-    pub phases: BTreeMap<String, MapMetrics>,
+    /// After each phase but the last, as `after_PHASE` (the wall scenario's `after_strafe`).
+    #[serde(flatten)]
+    pub after: BTreeMap<String, MapMetrics>,
 }
 
 /// What an experiment measured.
@@ -60,8 +66,10 @@ pub struct ExperimentReport {
     pub scenario: String,
     /// Pairs flown.
     pub pairs: usize,
-    /// Pairs the depth stage could not use (and why, for the first few).
+    /// Pairs the depth stage could not use.
     pub rejected_pairs: usize,
+    /// Pairs matched by plane sweep (motion along the view) rather than rectified.
+    pub swept_pairs: usize,
     /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, `fuzzy:OP`.
     pub maps: BTreeMap<String, MapReport>,
     /// Truly occupied voxels in the observed region.
@@ -118,8 +126,9 @@ pub fn run_experiment(
     };
     let mut phase_metrics: BTreeMap<String, BTreeMap<String, MapMetrics>> = BTreeMap::new();
     let (mut render_s, mut depth_s, mut integrate_s) = (0.0, 0.0, 0.0);
-    let mut rejected = 0;
-    for (phase, range) in &scenario.phases {
+    let (mut rejected, mut swept) = (0, 0);
+    let last_phase = scenario.phases.len().saturating_sub(1);
+    for (phase_index, (phase, range)) in scenario.phases.iter().enumerate() {
         for index in range.clone() {
             let Some((reference, other)) = scenario.pairs.get(index) else {
                 continue;
@@ -155,7 +164,10 @@ pub fn run_experiment(
             let result = depth_from_pair(&frame(0, *reference)?, &frame(1, *other)?, &depth);
             depth_s += t.elapsed().as_secs_f64();
             let depth_frame: DepthFrame = match result {
-                Ok(result) => result.frame,
+                Ok(result) => {
+                    swept += usize::from(result.method == MatchMethod::PlaneSweep);
+                    result.frame
+                }
                 Err(_) => {
                     rejected += 1;
                     continue;
@@ -167,9 +179,12 @@ pub fn run_experiment(
             }
             integrate_s += t.elapsed().as_secs_f64();
         }
+        if phase_index == last_phase {
+            continue;
+        }
         for (name, map) in &maps {
             phase_metrics.entry(name.clone()).or_default().insert(
-                (*phase).to_string(),
+                format!("after_{phase}"),
                 evaluate(map.as_map(), &truth, &scenario.scene),
             );
         }
@@ -180,9 +195,9 @@ pub fn run_experiment(
     let maps_report = maps
         .iter()
         .map(|(name, map)| {
-            let phases = phase_metrics.remove(name).unwrap_or_default();
+            let after = phase_metrics.remove(name).unwrap_or_default();
             let metrics = evaluate(map.as_map(), &truth, &scenario.scene);
-            (name.clone(), MapReport { metrics, phases })
+            (name.clone(), MapReport { metrics, after })
         })
         .collect();
     Ok((
@@ -190,6 +205,7 @@ pub fn run_experiment(
             scenario: scenario.name.to_string(),
             pairs: scenario.pairs.len(),
             rejected_pairs: rejected,
+            swept_pairs: swept,
             maps: maps_report,
             truth_occupied: truth.occupied_count(),
             seconds,

@@ -1,7 +1,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::truth::GroundTruth;
+use super::truth::{GroundTruth, meets_geometry};
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
 use crate::sim::Scene;
@@ -9,7 +9,8 @@ use crate::sim::Scene;
 /// How one map compares with the ground truth.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct MapMetrics {
-    /// Of the map's occupied voxels, the fraction that truly meet the geometry.
+    /// Of the map's occupied voxels, the fraction that truly meet the geometry (seen or not:
+    /// a voxel inside a solid wall is rightly occupied).
     pub occupied_precision: f64,
     /// Of the truly occupied voxels, the fraction the map calls occupied.
     pub occupied_recall: f64,
@@ -17,7 +18,8 @@ pub struct MapMetrics {
     pub occupied_f1: f64,
     /// Truly occupied voxels that the map calls free.
     pub holes: usize,
-    /// Voxels the map calls occupied outside the observed region (behind walls, in the sky).
+    /// Voxels the map calls occupied in the truly unknown region: outside the observed region
+    /// and not meeting the geometry (the empty space behind walls, the sky).
     pub spurious_unknown: usize,
     /// Mean distance (metres) from the map's occupied voxel centres to the true surface.
     pub chamfer_m: f64,
@@ -39,14 +41,23 @@ pub fn evaluate(map: &dyn VoxelMap, truth: &GroundTruth, scene: &Scene) -> MapMe
         .cells()
         .filter(|(_, m)| map.measure_config().classify(*m) == VoxelClass::Free)
         .count();
-    let true_positives = occupied.iter().filter(|k| truth.is_occupied(**k)).count();
-    let spurious_unknown = occupied.iter().filter(|k| !truth.is_observed(**k)).count();
+    let meets: Vec<bool> = occupied
+        .par_iter()
+        .map(|&k| truth.is_occupied(k) || meets_geometry(scene, resolution, k))
+        .collect();
+    let correct = meets.iter().filter(|&&m| m).count();
+    let found = occupied.iter().filter(|k| truth.is_occupied(**k)).count();
+    let spurious_unknown = occupied
+        .iter()
+        .zip(&meets)
+        .filter(|(k, m)| !**m && !truth.is_observed(**k))
+        .count();
     let holes = truth
         .occupied()
         .filter(|k| map.class_at(*k) == VoxelClass::Free)
         .count();
-    let precision = ratio(true_positives, occupied.len());
-    let recall = ratio(true_positives, truth.occupied_count());
+    let precision = ratio(correct, occupied.len());
+    let recall = ratio(found, truth.occupied_count());
     let f1 = if precision + recall > 0.0 {
         2.0 * precision * recall / (precision + recall)
     } else {
@@ -124,16 +135,23 @@ mod tests {
             occupied: 0.9,
             free: 0.0,
         };
+        // Unobserved but touching the wall's back face: rightly occupied, not spurious.
+        *evidence.cell_or_insert(VoxelKey::new(6, 1, 1)) = Evidence {
+            occupied: 0.9,
+            free: 0.0,
+        };
         let mut stored = FuzzyMap::new(FuzzyConfig::new(1.0).unwrap()).unwrap();
         stored.apply_evidence(&evidence);
         let m = evaluate(&stored, &truth, &scene);
-        assert_eq!(m.occupied, 4);
+        assert_eq!(m.occupied, 5);
         assert_eq!(m.holes, 1);
         assert_eq!(m.spurious_unknown, 1);
-        assert!((m.occupied_precision - 0.75).abs() < 1e-12);
+        assert!((m.occupied_precision - 0.8).abs() < 1e-12);
         assert!((m.occupied_recall - 0.75).abs() < 1e-12);
-        assert!((m.occupied_f1 - 0.75).abs() < 1e-12);
-        // Wall voxel centres lie inside the box (distance 0); the stray one is 1.5 m away.
-        assert!((m.chamfer_m - 1.5 / 4.0).abs() < 1e-4, "{}", m.chamfer_m);
+        let f1 = 2.0 * 0.8 * 0.75 / (0.8 + 0.75);
+        assert!((m.occupied_f1 - f1).abs() < 1e-12);
+        // Wall voxel centres lie inside the box (distance 0); the stray one is 1.5 m away, the
+        // one behind the wall 0.5 m.
+        assert!((m.chamfer_m - 2.0 / 5.0).abs() < 1e-4, "{}", m.chamfer_m);
     }
 }

@@ -44,16 +44,7 @@ impl GroundTruth {
         let occupied: Vec<VoxelKey> = observed
             .par_iter()
             .copied()
-            .filter(|&key| {
-                // A voxel meets the geometry when its closed box does: a surface lying exactly on
-                // a voxel face (flat ground at z = 0) belongs to the voxels on both sides, as
-                // rays ending on it fall on either side by rounding.
-                let touch = nalgebra::Vector3::repeat(1e-3 * resolution.size());
-                let low = resolution.corner(key) - touch;
-                let high =
-                    resolution.corner(VoxelKey::new(key.x + 1, key.y + 1, key.z + 1)) + touch;
-                scene.intersects_box(&low, &high)
-            })
+            .filter(|&key| meets_geometry(scene, resolution, key))
             .collect();
         Self::new(resolution, occupied, observed)
     }
@@ -87,6 +78,16 @@ impl GroundTruth {
     pub fn occupied(&self) -> impl Iterator<Item = VoxelKey> + '_ {
         self.occupied.iter().copied()
     }
+}
+
+/// Whether a voxel meets the scene geometry: its closed box, grown by a thousandth of a voxel,
+/// intersects a shape. A surface lying exactly on a voxel face (flat ground at z = 0) belongs
+/// to the voxels on both sides, as rays ending on it fall on either side by rounding.
+pub fn meets_geometry(scene: &Scene, resolution: Resolution, key: VoxelKey) -> bool {
+    let touch = nalgebra::Vector3::repeat(1e-3 * resolution.size());
+    let low = resolution.corner(key) - touch;
+    let high = resolution.corner(VoxelKey::new(key.x + 1, key.y + 1, key.z + 1)) + touch;
+    scene.intersects_box(&low, &high)
 }
 
 /// The paper's "gold standard": the scene's true depth, seen from every camera pose, inserted

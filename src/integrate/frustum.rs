@@ -7,7 +7,7 @@ use super::evidence::{
 };
 use crate::error::{Error, Result};
 use crate::ops::TConorm;
-use crate::storage::{BLOCK_CELLS, BLOCK_SIDE, Block, BlockKey, KeyBox, Resolution};
+use crate::storage::{AccessorMut, BLOCK_CELLS, BLOCK_SIDE, Block, BlockKey, KeyBox, Resolution};
 
 /// Largest frustum bounding box, in blocks, that one depth image may span (a guard against
 /// absurd depths; ordinary frames span thousands).
@@ -30,9 +30,9 @@ const TILE: u32 = 8;
 /// `P+ + δ`; its height `(2δ / (P+ - P- + 2δ))^f` (`f` = [`EvidenceModel::interval_falloff`])
 /// makes wide (far, uncertain) intervals commit less per voxel: `f = 1` keeps the evidence
 /// summed along the ray that of one sharp hit, `f = 0` gives every voxel of the interval the full
-/// evidence. A pixel whose depth
-/// exceeds `max_range` clears free space up to `max_range` and marks nothing occupied. Invalid
-/// pixels contribute nothing.
+/// evidence. The voxel that holds the pixel's `P0` point also gets the full occupied evidence
+/// of a hit (see [`mark_end_points`]). A pixel whose depth exceeds `max_range` clears free space
+/// up to `max_range` and marks nothing occupied. Invalid pixels contribute nothing.
 ///
 /// Blocks are found by culling the blocks of the frustum's bounding box against the largest far
 /// depth over 8×8 pixel tiles (conservative, so no observed block is missed) and are processed in
@@ -100,7 +100,42 @@ pub fn depth_evidence(
     for (key, block) in blocks {
         evidence.insert_block(key, block);
     }
+    mark_end_points(&mut evidence, frame, &pixels, resolution, model, operator);
     Ok((evidence, stats))
+}
+
+/// Gives the voxel that holds each pixel's most likely surface point (its `P0` back-projected)
+/// the full occupied evidence of a hit, `k_O` weighted by the pixel's confidence, as the point
+/// integrator does for its end voxel. The frustum's voxel-centre test alone misses surfaces
+/// that cross a voxel away from its centre (ground seen at a grazing angle), and the interval's
+/// kernel is deliberately weak when the interval is wide; the hit keeps the most likely point
+/// as strong as the paper's confidence-weighted point insertion. Evidence only rises, so the
+/// order of pixels does not matter.
+fn mark_end_points(
+    evidence: &mut ScanEvidence,
+    frame: &DepthFrame,
+    pixels: &[PixelEvidence],
+    resolution: &Resolution,
+    model: &EvidenceModel,
+    operator: &TConorm,
+) {
+    let k = frame.intrinsics();
+    let pose = frame.world_from_camera();
+    let width = k.width() as usize;
+    let mut cells = AccessorMut::new(evidence);
+    for (i, p) in pixels.iter().enumerate() {
+        if !p.is_valid() || p.height <= 0.0 {
+            continue;
+        }
+        let (u, v) = ((i % width) as f64, (i / width) as f64);
+        let point = pose * k.back_project(u, v, f64::from(p.depth));
+        // A point outside the key range was already refused by the frustum box; skip it.
+        if let Ok(key) = resolution.key_of(&point) {
+            let hit = model.occupied(operator, p.confidence, 1.0);
+            let cell = cells.get_or_insert(key);
+            cell.occupied = cell.occupied.max(hit);
+        }
+    }
 }
 
 /// What one pixel contributes, packed into 32 aligned bytes: voxels look their pixel up at

@@ -33,15 +33,16 @@ pub fn camera() -> Result<PinholeIntrinsics> {
     PinholeIntrinsics::new(320, 240, f, f, 159.5, 119.5)
 }
 
-/// The wall scenario: a 30 m × 8 m textured wall 12 m ahead over flat ground (its top at
-/// 1.3 cm, off the voxel grid). Six strafe pairs move sideways along the wall looking at it
+/// The wall scenario: a 30 m × 8 m textured wall 12 m ahead over flat ground (every face of
+/// the wall and the ground lies 1.3 cm off the voxel grids of 5, 10 and 20 cm, so that no
+/// surface coincides with a voxel face and counts on both sides of it). Six strafe pairs move sideways along the wall looking at it
 /// (0.4 m baseline: good stereo geometry); then six receding pairs move straight back from it,
 /// looking nearly level at it (0.4 m along the view: poor geometry, where monocular depth is
 /// least certain).
 pub fn wall() -> Result<Scenario> {
     let mut scene = Scene::new();
     scene.add_ground(0.013, 400.0).add_box(
-        Point3::new(12.25, 0.0, 4.0),
+        Point3::new(12.263, 0.013, 4.013),
         Vector3::new(0.25, 15.0, 4.0),
         0.0,
         SurfaceKind::Wall,

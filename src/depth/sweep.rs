@@ -1,0 +1,421 @@
+//! Plane-sweep matching in the original reference camera, for pairs that cannot be rectified
+//! usefully (motion along the look direction puts the epipole inside the image).
+//!
+//! Fronto-parallel planes at inverse depths `w_k = w_far + k · Δw` (`k = 0 .. K`) play the part
+//! of disparities: a reference pixel `x` on plane `k` maps into the other image at
+//! `π(M x̃ + w_k K_o t)`, where `M = K_o R K_r⁻¹` and `(R, t)` is `other_from_reference`. `Δw` is
+//! chosen so that no pixel moves more than one pixel between neighbouring planes. Each plane's
+//! cost is the census Hamming distance to the other image's nearest pixel, aggregated over the
+//! same window as the row matcher; winner-takes-all with a parabola refinement, the uniqueness
+//! test and the cost-curve range follow, exactly as for rectified pairs. Because `w` is affine
+//! in the plane index, depth is `1 / (w_far + k Δw)`, which is a [`StereoGeometry`] with
+//! `baseline · f = 1 / Δw` and `doffs = w_far / Δw`: the interval and confidence code of
+//! rectified pairs applies unchanged.
+//!
+//! Near the epipole the planes barely move a pixel, the cost curve is flat and the uniqueness
+//! test drops the pixel, or its cost-curve interval is wide and its confidence low: the honest
+//! answer for motion along the view. There is no left-right check (the other image has no
+//! sweep of its own).
+//!
+//! Memory is bounded by the image: the image is cut into bands of rows that threads sweep
+//! independently (each band with a halo of half a window), in two streaming passes over the
+//! planes (best cost and its neighbours; then the runner-up and the cost-curve range).
+
+use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
+
+use super::census::{CENSUS_MAX_COST, CensusImage, census_transform};
+use super::frame::Frame;
+use super::params::{DisparityMap, MAX_DISPARITIES, MatchParams};
+use super::rectify::{MIN_BASELINE, StereoGeometry, UnrectifiableReason};
+use crate::error::{Error, Result};
+
+/// Rows per band of the sweep (plus a halo of half a window above and below).
+const BAND_ROWS: usize = 32;
+
+/// The planes of a sweep and the geometry that turns a plane index into depth.
+#[derive(Clone, Debug)]
+pub(crate) struct Sweep {
+    /// `K_o R K_r⁻¹`, in single precision.
+    homography: [[f32; 3]; 3],
+    /// `K_o t`.
+    translation: [f32; 3],
+    /// Inverse depth of plane 0 (the farthest).
+    inverse_far: f64,
+    /// Inverse-depth step between planes.
+    step: f64,
+    /// Number of planes.
+    planes: u32,
+}
+
+impl Sweep {
+    /// The planes covering depths `near ..= far` for this pair.
+    pub(crate) fn new(reference: &Frame, other: &Frame, near: f64, far: f64) -> Result<Self> {
+        if !(near.is_finite() && near > 0.0 && far > near) {
+            return Err(Error::InvalidParameter {
+                name: "depth range",
+                value: near,
+                expected: "0 < near < far",
+            });
+        }
+        let other_from_reference =
+            other.world_from_camera().inverse() * reference.world_from_camera();
+        let t = other_from_reference.translation.vector;
+        if t.norm() <= MIN_BASELINE || !t.norm().is_finite() {
+            return Err(Error::Unrectifiable {
+                reason: UnrectifiableReason::ZeroBaseline { baseline: t.norm() },
+            });
+        }
+        let kr = reference.intrinsics();
+        let ko = other.intrinsics();
+        let k_other = Matrix3::new(ko.fx(), 0.0, ko.cx(), 0.0, ko.fy(), ko.cy(), 0.0, 0.0, 1.0);
+        let k_reference_inverse = Matrix3::new(
+            1.0 / kr.fx(),
+            0.0,
+            -kr.cx() / kr.fx(),
+            0.0,
+            1.0 / kr.fy(),
+            -kr.cy() / kr.fy(),
+            0.0,
+            0.0,
+            1.0,
+        );
+        let m = k_other
+            * other_from_reference.rotation.to_rotation_matrix().matrix()
+            * k_reference_inverse;
+        let b = k_other * t;
+        let (inverse_near, inverse_far) =
+            (1.0 / near, if far.is_finite() { 1.0 / far } else { 0.0 });
+        // The largest image motion per unit of inverse depth over a grid of pixels and depths
+        // bounds the plane step.
+        let (w, h) = (f64::from(kr.width()), f64::from(kr.height()));
+        let mut rate: f64 = 0.0;
+        for (fx, fy) in
+            (0..5).flat_map(|i| (0..5).map(move |j| (f64::from(i) / 4.0, f64::from(j) / 4.0)))
+        {
+            let a = m * Vector3::new(fx * (w - 1.0), fy * (h - 1.0), 1.0);
+            let mut previous: Option<(f64, f64)> = None;
+            const SAMPLES: u32 = 32;
+            for s in 0..=SAMPLES {
+                let inverse =
+                    inverse_far + (inverse_near - inverse_far) * f64::from(s) / f64::from(SAMPLES);
+                let q = a + b * inverse;
+                if q.z <= 1e-12 {
+                    previous = None;
+                    continue;
+                }
+                let p = (q.x / q.z, q.y / q.z);
+                if let Some(prev) = previous {
+                    let moved = ((p.0 - prev.0).powi(2) + (p.1 - prev.1).powi(2)).sqrt();
+                    rate = rate.max(moved * f64::from(SAMPLES) / (inverse_near - inverse_far));
+                }
+                previous = Some(p);
+            }
+        }
+        let planes = (rate * (inverse_near - inverse_far)).ceil() + 1.0;
+        if !(planes.is_finite() && planes <= f64::from(MAX_DISPARITIES)) {
+            return Err(Error::InvalidParameter {
+                name: "plane count for the depth range",
+                value: planes,
+                expected: "1 to 1024 planes (narrow the depth range)",
+            });
+        }
+        let planes = planes.max(2.0) as u32;
+        let step = (inverse_near - inverse_far) / f64::from(planes - 1);
+        let cast = |v: f64| v as f32;
+        Ok(Self {
+            homography: std::array::from_fn(|r| std::array::from_fn(|c| cast(m[(r, c)]))),
+            translation: [cast(b.x), cast(b.y), cast(b.z)],
+            inverse_far,
+            step,
+            planes,
+        })
+    }
+
+    /// The geometry that maps a (fractional) plane index to depth in the reference camera.
+    pub(crate) fn geometry(&self, reference: &Frame) -> Result<StereoGeometry> {
+        let fx = reference.intrinsics().fx();
+        StereoGeometry::new(
+            *reference.intrinsics(),
+            *reference.world_from_camera(),
+            1.0 / (self.step * fx),
+            self.inverse_far / self.step,
+        )
+    }
+
+    /// Raw census costs of reference row `y` on plane `k`, written into `out` (one per column).
+    fn row_costs(
+        &self,
+        y: usize,
+        k: u32,
+        reference: &CensusImage,
+        other: &CensusImage,
+        out: &mut [u8],
+    ) {
+        let inverse = (self.inverse_far + self.step * f64::from(k)) as f32;
+        let [m0, m1, m2] = self.homography;
+        let b = self.translation;
+        let yf = y as f32;
+        let (w, h) = (other.width as f32, other.height as f32);
+        let row = y * reference.width;
+        for (x, cost) in out.iter_mut().enumerate() {
+            let xf = x as f32;
+            let qz = m2[0] * xf + m2[1] * yf + m2[2] + inverse * b[2];
+            let qx = m0[0] * xf + m0[1] * yf + m0[2] + inverse * b[0];
+            let qy = m1[0] * xf + m1[1] * yf + m1[2] + inverse * b[1];
+            *cost = CENSUS_MAX_COST;
+            if qz <= 1e-6 || !reference.valid[row + x] {
+                continue;
+            }
+            let (u, v) = ((qx / qz + 0.5).floor(), (qy / qz + 0.5).floor());
+            if u >= 0.0 && v >= 0.0 && u < w && v < h {
+                let j = v as usize * other.width + u as usize;
+                if other.valid[j] {
+                    *cost = (reference.codes[row + x] ^ other.codes[j]).count_ones() as u8;
+                }
+            }
+        }
+    }
+}
+
+/// Per-pixel state of the two passes.
+#[derive(Clone, Copy)]
+struct PixelState {
+    best: u16,
+    best_plane: u32,
+    left: u16,
+    right: u16,
+    runner_up: u16,
+    low: u32,
+    high: u32,
+}
+
+impl Default for PixelState {
+    fn default() -> Self {
+        Self {
+            best: u16::MAX,
+            best_plane: 0,
+            left: u16::MAX,
+            right: u16::MAX,
+            runner_up: u16::MAX,
+            low: u32::MAX,
+            high: 0,
+        }
+    }
+}
+
+/// Box sums of a band's raw costs: `raw` holds rows `first ..` of the image (the band and its
+/// halo), `out` the aggregated rows `y0 .. y0 + out.len() / width`. Windows are clipped at the
+/// image border, which keeps each pixel's window the same on every plane.
+#[allow(clippy::too_many_arguments)]
+fn aggregate(
+    raw: &[u8],
+    first: usize,
+    width: usize,
+    y0: usize,
+    radius: (usize, usize),
+    height: usize,
+    horizontal: &mut [u16],
+    out: &mut [u16],
+) {
+    let (rx, ry) = radius;
+    let rows = raw.len() / width;
+    for r in 0..rows {
+        let src = &raw[r * width..(r + 1) * width];
+        let dst = &mut horizontal[r * width..(r + 1) * width];
+        let mut sum: u16 = src[..(rx + 1).min(width)]
+            .iter()
+            .map(|&c| u16::from(c))
+            .sum();
+        for x in 0..width {
+            dst[x] = sum;
+            if x + rx + 1 < width {
+                sum += u16::from(src[x + rx + 1]);
+            }
+            if x >= rx {
+                sum -= u16::from(src[x - rx]);
+            }
+        }
+    }
+    for (i, row) in out.chunks_exact_mut(width).enumerate() {
+        let y = y0 + i;
+        let top = y.saturating_sub(ry).max(first) - first;
+        let bottom = (y + ry).min(height - 1) - first;
+        row.fill(0);
+        for r in top..=bottom {
+            for (o, &s) in row.iter_mut().zip(&horizontal[r * width..(r + 1) * width]) {
+                *o += s;
+            }
+        }
+    }
+}
+
+/// Sweeps one band of rows `y0 .. y1` through every plane, twice, and returns its pixels' state.
+fn sweep_band(
+    sweep: &Sweep,
+    reference: &CensusImage,
+    other: &CensusImage,
+    params: &MatchParams,
+    y0: usize,
+    y1: usize,
+) -> Vec<PixelState> {
+    let width = reference.width;
+    let height = reference.height;
+    let radius = (
+        params.window_width as usize / 2,
+        params.window_height as usize / 2,
+    );
+    let first = y0.saturating_sub(radius.1);
+    let last = (y1 + radius.1).min(height);
+    let mut raw = vec![0u8; (last - first) * width];
+    let mut horizontal = vec![0u16; raw.len()];
+    let mut costs = vec![0u16; (y1 - y0) * width];
+    let mut previous = vec![u16::MAX; costs.len()];
+    let mut state = vec![PixelState::default(); costs.len()];
+    let mut plane_costs = |k: u32, costs: &mut [u16]| {
+        for (r, row) in raw.chunks_exact_mut(width).enumerate() {
+            sweep.row_costs(first + r, k, reference, other, row);
+        }
+        aggregate(
+            &raw,
+            first,
+            width,
+            y0,
+            radius,
+            height,
+            &mut horizontal,
+            costs,
+        );
+    };
+    // Pass 1: the best plane and the costs on either side of it.
+    for k in 0..sweep.planes {
+        plane_costs(k, &mut costs);
+        for ((s, &c), &p) in state.iter_mut().zip(&costs).zip(&previous) {
+            if c < s.best {
+                (s.best, s.best_plane, s.left, s.right) = (c, k, p, u16::MAX);
+            } else if k == s.best_plane + 1 && s.best != u16::MAX {
+                s.right = c;
+            }
+        }
+        previous.copy_from_slice(&costs);
+    }
+    // Pass 2: the best cost more than one plane away, and the cost-curve range.
+    let tolerance = 1.0 + f64::from(params.range_tolerance);
+    let limits: Vec<u16> = state
+        .iter()
+        .map(|s| (f64::from(s.best) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
+        .collect();
+    for k in 0..sweep.planes {
+        plane_costs(k, &mut costs);
+        for ((s, &c), &limit) in state.iter_mut().zip(&costs).zip(&limits) {
+            if k.abs_diff(s.best_plane) > 1 {
+                s.runner_up = s.runner_up.min(c);
+            }
+            if c <= limit {
+                s.low = s.low.min(k);
+                s.high = s.high.max(k);
+            }
+        }
+    }
+    state
+}
+
+/// Matches a pair by plane sweep in the reference camera; the result's "disparity" is the
+/// fractional plane index.
+pub(crate) fn sweep_pair(
+    reference: &Frame,
+    other: &Frame,
+    sweep: &Sweep,
+    params: &MatchParams,
+) -> Result<DisparityMap> {
+    params.validate()?;
+    let left = census_transform(reference.image());
+    let right = census_transform(other.image());
+    let (width, height) = (left.width, left.height);
+    if width == 0 || height == 0 {
+        return Err(Error::Empty("reference image"));
+    }
+    let bands: Vec<(usize, usize)> = (0..height)
+        .step_by(BAND_ROWS)
+        .map(|y0| (y0, (y0 + BAND_ROWS).min(height)))
+        .collect();
+    let states: Vec<Vec<PixelState>> = bands
+        .par_iter()
+        .map(|&(y0, y1)| sweep_band(sweep, &left, &right, params, y0, y1))
+        .collect();
+    let n = width * height;
+    let mut map = DisparityMap {
+        width: width as u32,
+        height: height as u32,
+        disparity: vec![f32::NAN; n],
+        range_low: vec![f32::NAN; n],
+        range_high: vec![f32::NAN; n],
+    };
+    let max_cost = u32::from(CENSUS_MAX_COST) * params.window_width * params.window_height;
+    let ratio = params.uniqueness_ratio;
+    for (i, s) in states.iter().flatten().enumerate() {
+        if s.best == u16::MAX || u32::from(s.best) >= max_cost || s.low > s.high {
+            continue;
+        }
+        if ratio > 0 && u32::from(s.runner_up) * (100 - ratio) < u32::from(s.best) * 100 {
+            continue;
+        }
+        let mut offset = 0.0f32;
+        if s.left != u16::MAX && s.right != u16::MAX {
+            let (l, b, r) = (f32::from(s.left), f32::from(s.best), f32::from(s.right));
+            let curvature = l + r - 2.0 * b;
+            if curvature > 0.0 {
+                offset = ((l - r) / (2.0 * curvature)).clamp(-0.5, 0.5);
+            }
+        }
+        map.disparity[i] = s.best_plane as f32 + offset;
+        map.range_low[i] = s.low as f32;
+        map.range_high[i] = s.high as f32;
+    }
+    Ok(map)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::depth::GrayImage;
+    use crate::geometry::PinholeIntrinsics;
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+    fn frame(image: GrayImage, k: PinholeIntrinsics, x: f64, z: f64) -> Frame {
+        let pose = Isometry3::from_parts(Translation3::new(x, 0.0, z), UnitQuaternion::identity());
+        Frame::new(image, k, pose, 0.0).unwrap()
+    }
+
+    #[test]
+    fn plane_index_maps_to_the_swept_depths() {
+        let k = PinholeIntrinsics::new(64, 48, 50.0, 50.0, 31.5, 23.5).unwrap();
+        let image = GrayImage::new(64, 48, vec![0.5; 64 * 48]).unwrap();
+        let a = frame(image.clone(), k, 0.0, 0.0);
+        let b = frame(image, k, 0.0, -0.5);
+        let sweep = Sweep::new(&a, &b, 2.0, 20.0).unwrap();
+        let geometry = sweep.geometry(&a).unwrap();
+        let near = geometry.depth(f64::from(sweep.planes - 1)).unwrap();
+        let far = geometry.depth(0.0).unwrap();
+        assert!((near - 2.0).abs() < 1e-9 && (far - 20.0).abs() < 1e-9);
+        // Forward motion of 0.5 m: a corner pixel (about 40 px from the centre) moves
+        // 40 · 0.5 · (1/2 - 1/20) ≈ 9 px over the range, so about ten planes.
+        assert!((8..=14).contains(&sweep.planes), "{}", sweep.planes);
+    }
+
+    #[test]
+    fn zero_baseline_and_bad_ranges_are_errors() {
+        let k = PinholeIntrinsics::new(16, 16, 20.0, 20.0, 7.5, 7.5).unwrap();
+        let image = GrayImage::new(16, 16, vec![0.5; 256]).unwrap();
+        let a = frame(image.clone(), k, 0.0, 0.0);
+        assert!(matches!(
+            Sweep::new(&a, &a, 1.0, 10.0),
+            Err(Error::Unrectifiable {
+                reason: UnrectifiableReason::ZeroBaseline { .. }
+            })
+        ));
+        let b = frame(image, k, 0.0, -1.0);
+        assert!(Sweep::new(&a, &b, 10.0, 1.0).is_err());
+        assert!(Sweep::new(&a, &b, f64::NAN, 1.0).is_err());
+    }
+}
