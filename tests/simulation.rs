@@ -59,8 +59,9 @@ fn the_wall_experiment_is_reproducible_and_reports_every_map() {
         operators: vec!["max".parse().unwrap()],
         ..ExperimentConfig::default()
     };
-    let (first, maps) = run_experiment(&scenario, &config).unwrap();
-    let (second, _) = run_experiment(&scenario, &config).unwrap();
+    let output = run_experiment(&scenario, &config).unwrap();
+    let (first, maps) = (output.report, output.maps);
+    let second = run_experiment(&scenario, &config).unwrap().report;
     let names: Vec<_> = first.maps.keys().cloned().collect();
     assert_eq!(names, ["alpha", "fuzzy", "fuzzy:minimum", "logodds"]);
     for name in &names {

@@ -4,21 +4,24 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::eval::{ExperimentConfig, ExperimentReport, run_experiment, top_down_png};
+use fuzzyvox::eval::{file_stem, run_experiment, write_experiment};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
-use fuzzyvox::sim::scenario::{self, Scenario};
+use fuzzyvox::sim::scenario;
+
+use super::eval::experiment_config;
 
 /// The simulated flight demo: a drone's camera maps the paper's two scenes (a wall, then a
 /// random flight over buildings and trees) with the standard log-odds map, the alpha-cut map
-/// and the fuzzy map, from the same depth-stage output, and the report compares them against
-/// the true scene.
+/// and the fuzzy map, from the same depth-stage output; flights are planned in every map and
+/// checked against the true scene, and the report compares everything side by side.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  fuzzyvox demo\n  fuzzyvox demo --out my-demo --full")]
 pub struct DemoArgs {
     /// Where to write the report, metrics, maps and figures.
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
-    /// Fly the paper-scale random flight (700 pairs) instead of the short one (60 pairs).
+    /// Fly the paper-scale random flight (700 pairs, 100 planned flights) instead of the short
+    /// one (60 pairs, 30 flights).
     #[arg(long)]
     full: bool,
 }
@@ -27,65 +30,41 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let pairs = if args.full { 700 } else { 60 };
+    let (pairs, flights) = if args.full { (700, 100) } else { (60, 30) };
     let mut report = String::from("# fuzzyvox demo\n\n");
     let _ = writeln!(
         report,
         "A simulated camera flies through two scenes. Every stereo pair goes through the depth \
          stage once, and the same interval depth feeds three maps: the standard log-odds map \
          (OctoMap's method), the alpha-cut map (confidence cuts) and the dual-set fuzzy map. \
-         Each map is then compared with the true scene.\n"
+         Each map is then compared with the true scene, and flights planned in each map are \
+         checked against the true geometry.\n"
     );
     let mut all = serde_json::Map::new();
-    for (scenario, extent) in [
-        (scenario::wall()?, ([-8.0, -16.0], [14.0, 16.0])),
-        (scenario::random(pairs, 1)?, ([-65.0, -65.0], [65.0, 65.0])),
-    ] {
+    for scenario in [scenario::wall()?, scenario::random(pairs, 1)?] {
         eprintln!(
             "[{:>5.1} s] {} scenario: {} stereo pairs ...",
             started.elapsed().as_secs_f64(),
             scenario.name,
             scenario.pairs.len()
         );
-        let (result, maps) = run_experiment(&scenario, &ExperimentConfig::default())?;
-        section(&mut report, &scenario, &result);
-        for (name, map) in &maps {
-            let stem = format!("{}-{}", scenario.name, name.replace(':', "_"));
-            map.save(args.out.join(format!("{stem}.fvx")))?;
+        let config = experiment_config(&scenario, 0.2, Vec::new(), 1, flights);
+        let output = run_experiment(&scenario, &config)?;
+        let (section, _) = write_experiment(&args.out, &scenario, &output)?;
+        report.push_str(&section);
+        for (name, map) in &output.maps {
+            let stem = format!("{}-{}", scenario.name, file_stem(name));
             write_bt_max_likelihood(&args.out.join(format!("{stem}.bt")), map.as_map())?;
-            top_down_png(
-                map.as_map(),
-                extent.0,
-                extent.1,
-                [0.0, 8.0],
-                &args.out.join(format!("{stem}.png")),
-            )?;
         }
-        let _ = writeln!(
-            report,
-            "| {} |",
-            maps.iter()
-                .map(|(n, _)| n.as_str())
-                .collect::<Vec<_>>()
-                .join(" | ")
+        all.insert(
+            scenario.name.to_string(),
+            serde_json::to_value(&output.report)?,
         );
-        let _ = writeln!(report, "|{}", "---|".repeat(maps.len()));
-        let _ = writeln!(
-            report,
-            "| {} |\n",
-            maps.iter()
-                .map(|(n, _)| format!("![{n}]({}-{}.png)", scenario.name, n.replace(':', "_")))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
-        all.insert(scenario.name.to_string(), serde_json::to_value(&result)?);
     }
     let _ = writeln!(
         report,
-        "Top-down views: occupied voxel columns coloured by height (blue low, yellow high), free \
-         space light green, unknown white. Each map is also saved as `.fvx` (open with \
-         `fuzzyvox info`, plan with `fuzzyvox plan`) and `.bt` (OctoMap's tools and octovis).\n\n\
-         Total time {:.1} s.",
+        "Each map is also saved as `.fvx` (open with `fuzzyvox info`, plan with `fuzzyvox \
+         plan`) and `.bt` (OctoMap's tools and octovis).\n\nTotal time {:.1} s.",
         started.elapsed().as_secs_f64()
     );
     fuzzyvox::io::write_atomic(&args.out.join("report.md"), report.as_bytes())?;
@@ -99,32 +78,4 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
-}
-
-/// The report's section for one scenario: what was flown and the metrics table.
-fn section(report: &mut String, scenario: &Scenario, result: &ExperimentReport) {
-    let _ = writeln!(
-        report,
-        "## {} scenario\n\n{} stereo pairs ({} could not be rectified and were skipped), {} truly \
-         occupied voxels in the region the cameras saw.\n",
-        scenario.name, result.pairs, result.rejected_pairs, result.truth_occupied
-    );
-    let _ = writeln!(
-        report,
-        "| map | occupied precision | recall | F1 | holes | spurious (unknown region) | Chamfer (m) |\n|---|---|---|---|---|---|---|"
-    );
-    for (name, map) in &result.maps {
-        let m = &map.metrics;
-        let _ = writeln!(
-            report,
-            "| {name} | {:.3} | {:.3} | {:.3} | {} | {} | {:.3} |",
-            m.occupied_precision,
-            m.occupied_recall,
-            m.occupied_f1,
-            m.holes,
-            m.spurious_unknown,
-            m.chamfer_m
-        );
-    }
-    let _ = writeln!(report);
 }

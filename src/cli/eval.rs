@@ -4,23 +4,26 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use fuzzyvox::Family;
-use fuzzyvox::eval::{ExperimentConfig, run_experiment};
-use fuzzyvox::sim::scenario;
+use fuzzyvox::eval::{ExperimentConfig, FlightConfig, run_experiment, write_experiment};
+use fuzzyvox::sim::scenario::{self, Scenario};
 
 /// Run one of the paper's scenarios: render every stereo pair, run the depth stage, feed the
-/// same depth to the log-odds, alpha-cut and fuzzy maps, and measure each against the truth.
+/// same depth to the log-odds, alpha-cut and fuzzy maps, and measure each against the truth;
+/// optionally plan flights in every map and check them against the true scene.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
     fuzzyvox eval --scenario wall --json\n  \
-    fuzzyvox eval --scenario random --pairs 300 --seed 7 --ops max,dombi:2 --out eval-random")]
+    fuzzyvox eval --scenario wall --out eval-wall        # report.md with figures\n  \
+    fuzzyvox eval --scenario random --pairs 300 --plan 100 --out eval-random\n  \
+    fuzzyvox eval --scenario random --pairs 100 --seed 7 --ops max,dombi:2 --json")]
 pub struct EvalArgs {
     /// Which scenario.
     #[arg(long, value_enum)]
-    scenario: Scenario,
-    /// Stereo pairs of the random flight.
+    scenario: ScenarioName,
+    /// Stereo pairs of the random flight (the wall scenario always has 12).
     #[arg(long, default_value_t = 100)]
     pairs: usize,
-    /// Seed of the random flight and of the sensor noise.
+    /// Seed of the random flight, the sensor noise and the flight queries.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Extra fuzzy maps, one per t-conorm (comma-separated NAME[:PARAM]).
@@ -29,7 +32,10 @@ pub struct EvalArgs {
     /// Voxel size in metres.
     #[arg(long, default_value_t = 0.2)]
     res: f64,
-    /// Write `metrics.json` and each map (native format) here.
+    /// Plan this many random flights in every map and check them against the true scene.
+    #[arg(long, default_value_t = 0)]
+    plan: usize,
+    /// Write metrics.json, report.md, every map (.fvx) and the figures (PNG) here.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Print the report as one JSON object.
@@ -38,46 +44,87 @@ pub struct EvalArgs {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
-enum Scenario {
+pub enum ScenarioName {
     /// A wall seen by 6 strafing, then 6 receding stereo pairs.
     Wall,
     /// A random flight over terrain with buildings and trees.
     Random,
 }
 
+impl ScenarioName {
+    /// Builds the scenario.
+    pub fn build(self, pairs: usize, seed: u64) -> fuzzyvox::Result<Scenario> {
+        match self {
+            Self::Wall => scenario::wall(),
+            Self::Random => scenario::random(pairs, seed),
+        }
+    }
+}
+
+/// The experiment settings of the CLI: the pairs whose depth images go in the report are the
+/// first pair of each phase and, for longer flights, one in the middle.
+pub fn experiment_config(
+    scenario: &Scenario,
+    resolution: f64,
+    operators: Vec<Family>,
+    seed: u64,
+    plan: usize,
+) -> ExperimentConfig {
+    let mut sample_pairs: Vec<usize> = scenario.phases.iter().map(|(_, r)| r.start).collect();
+    if scenario.phases.len() == 1 && scenario.pairs.len() > 2 {
+        sample_pairs.push(scenario.pairs.len() / 2);
+    }
+    ExperimentConfig {
+        resolution,
+        operators,
+        seed,
+        flights: (plan > 0).then(|| FlightConfig {
+            queries: plan,
+            seed,
+            ..FlightConfig::default()
+        }),
+        sample_pairs,
+        ..ExperimentConfig::default()
+    }
+}
+
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    if args.pairs == 0 {
+        anyhow::bail!("--pairs must be at least 1");
+    }
     let operators = args
         .ops
         .iter()
         .map(|op| op.parse::<Family>().with_context(|| format!("--ops {op}")))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let scenario = match args.scenario {
-        Scenario::Wall => scenario::wall()?,
-        Scenario::Random => scenario::random(args.pairs, args.seed)?,
-    };
-    let config = ExperimentConfig {
-        resolution: args.res,
-        operators,
-        seed: args.seed,
-        ..ExperimentConfig::default()
-    };
+    let scenario = args.scenario.build(args.pairs, args.seed)?;
+    let config = experiment_config(&scenario, args.res, operators, args.seed, args.plan);
     let started = Instant::now();
-    let (report, maps) = run_experiment(&scenario, &config)?;
+    let output = run_experiment(&scenario, &config)?;
     let seconds = started.elapsed().as_secs_f64();
+    let report = &output.report;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let json = serde_json::to_string_pretty(&report)?;
+        let json = serde_json::to_string_pretty(report)?;
         fuzzyvox::io::write_atomic(&dir.join("metrics.json"), json.as_bytes())?;
-        for (name, map) in &maps {
-            map.save(dir.join(format!("{}.fvx", name.replace(':', "_"))))?;
-        }
+        let (section, _) = write_experiment(dir, &scenario, &output)?;
+        let page = format!(
+            "# fuzzyvox eval: {} scenario\n\nCommand: `fuzzyvox eval --scenario {} --pairs {} \
+             --seed {} --res {} --plan {}`; {seconds:.1} s.\n\n{section}",
+            scenario.name, scenario.name, report.pairs, args.seed, args.res, args.plan
+        );
+        fuzzyvox::io::write_atomic(&dir.join("report.md"), page.as_bytes())?;
     }
     if args.json {
-        return super::print_json(&serde_json::to_value(&report)?);
+        return super::print_json(&serde_json::to_value(report)?);
     }
     println!(
-        "{} scenario: {} pairs ({} rejected by the depth stage) in {seconds:.1} s; {} truly occupied voxels",
-        report.scenario, report.pairs, report.rejected_pairs, report.truth_occupied
+        "{} scenario: {} pairs ({} by plane sweep, {} rejected) in {seconds:.1} s; {} truly occupied voxels",
+        report.scenario,
+        report.pairs,
+        report.swept_pairs,
+        report.rejected_pairs,
+        report.truth_occupied
     );
     println!(
         "{:<16} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9}",
@@ -94,6 +141,30 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
             m.spurious_unknown,
             m.chamfer_m
         );
+    }
+    if report.maps.values().any(|m| m.flights.is_some()) {
+        println!(
+            "{:<16} {:>9} {:>9} {:>10} {:>12}",
+            "flights", "queries", "success", "collisions", "length ratio"
+        );
+        let truth = report.truth_flights.iter().map(|f| ("ground truth", f));
+        let maps = report
+            .maps
+            .iter()
+            .filter_map(|(n, m)| Some((n.as_str(), m.flights.as_ref()?)));
+        for (name, f) in truth.chain(maps) {
+            println!(
+                "{name:<16} {:>9} {:>9.2} {:>10} {:>12}",
+                f.plan_queries,
+                f.plan_success,
+                f.plan_collisions,
+                f.path_length_ratio
+                    .map_or("-".to_string(), |r| format!("{r:.3}"))
+            );
+        }
+    }
+    if let Some(dir) = &args.out {
+        println!("wrote {}", dir.join("report.md").display());
     }
     Ok(())
 }

@@ -7,6 +7,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::flights::{FlightConfig, FlightOutcome, FlightQuery, FlightSummary, fly, flight_queries, summarize};
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
 use crate::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, depth_from_pair};
@@ -16,7 +17,7 @@ use crate::map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
 };
 use crate::ops::{Family, TConorm};
-use crate::sim::render;
+use crate::sim::{RenderedFrame, render};
 use crate::sim::scenario::Scenario;
 
 /// Settings of an experiment.
@@ -32,6 +33,10 @@ pub struct ExperimentConfig {
     pub depth: DepthParams,
     /// Seed of the sensor noise.
     pub seed: u64,
+    /// Planned flights checked against the true scene after the last phase; `None`: none.
+    pub flights: Option<FlightConfig>,
+    /// Pairs (by index) whose depth-stage output is kept for figures.
+    pub sample_pairs: Vec<usize>,
 }
 
 impl Default for ExperimentConfig {
@@ -44,6 +49,8 @@ impl Default for ExperimentConfig {
                 ..DepthParams::default()
             },
             seed: 1,
+            flights: None,
+            sample_pairs: Vec::new(),
         }
     }
 }
@@ -57,6 +64,36 @@ pub struct MapReport {
     /// After each phase but the last, as `after_PHASE` (the wall scenario's `after_strafe`).
     #[serde(flatten)]
     pub after: BTreeMap<String, MapMetrics>,
+    /// Planned flights, when the experiment flew any.
+    #[serde(flatten)]
+    pub flights: Option<FlightSummary>,
+}
+
+/// One pair's depth-stage output kept for figures, with the truth seen from the same camera.
+#[derive(Clone, Debug)]
+pub struct DepthSample {
+    /// Index of the pair in the scenario.
+    pub pair: usize,
+    /// The depth stage's interval depth and confidence.
+    pub frame: DepthFrame,
+    /// The scene rendered from the frame's (rectified) camera: image and true depth.
+    pub truth: RenderedFrame,
+}
+
+/// Everything an experiment produced.
+pub struct ExperimentOutput {
+    /// The figures.
+    pub report: ExperimentReport,
+    /// Every map, by name, in report order.
+    pub maps: Vec<(String, AnyMap)>,
+    /// The gold-standard map (true depth inserted with the standard method).
+    pub gold: AnyMap,
+    /// The kept depth-stage outputs.
+    pub samples: Vec<DepthSample>,
+    /// The flights' start/goal pairs.
+    pub flight_queries: Vec<FlightQuery>,
+    /// Each map's flight outcomes by name (the ground-truth map as `truth`).
+    pub flights: Vec<(String, Vec<FlightOutcome>)>,
 }
 
 /// What an experiment measured.
@@ -72,6 +109,9 @@ pub struct ExperimentReport {
     pub swept_pairs: usize,
     /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, `fuzzy:OP`.
     pub maps: BTreeMap<String, MapReport>,
+    /// Flights planned in the gold-standard map, the reference for path lengths.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub truth_flights: Option<FlightSummary>,
     /// Truly occupied voxels in the observed region.
     pub truth_occupied: usize,
     /// Seconds spent rendering, in the depth stage, and integrating.
@@ -81,10 +121,16 @@ pub struct ExperimentReport {
 /// Runs a scenario: renders every pair, runs the depth stage once per pair, feeds the same
 /// depth frames to every map, and evaluates every map after each phase against the ground
 /// truth (the scene's geometry inside the region the gold standard observed).
-pub fn run_experiment(
+pub fn run_experiment(scenario: &Scenario, config: &ExperimentConfig) -> Result<ExperimentOutput> {
+    run_experiment_with_progress(scenario, config, &mut |_, _| {})
+}
+
+/// [`run_experiment`], calling `progress(done, total)` after each pair.
+pub fn run_experiment_with_progress(
     scenario: &Scenario,
     config: &ExperimentConfig,
-) -> Result<(ExperimentReport, Vec<(String, AnyMap)>)> {
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<ExperimentOutput> {
     let mut maps: Vec<(String, AnyMap)> = vec![
         (
             "logodds".into(),
@@ -127,12 +173,16 @@ pub fn run_experiment(
     let mut phase_metrics: BTreeMap<String, BTreeMap<String, MapMetrics>> = BTreeMap::new();
     let (mut render_s, mut depth_s, mut integrate_s) = (0.0, 0.0, 0.0);
     let (mut rejected, mut swept) = (0, 0);
+    let mut samples = Vec::new();
+    let mut done = 0;
     let last_phase = scenario.phases.len().saturating_sub(1);
     for (phase_index, (phase, range)) in scenario.phases.iter().enumerate() {
         for index in range.clone() {
             let Some((reference, other)) = scenario.pairs.get(index) else {
                 continue;
             };
+            done += 1;
+            progress(done, scenario.pairs.len());
             let t = Instant::now();
             let seed = config
                 .seed
@@ -166,6 +216,19 @@ pub fn run_experiment(
             let depth_frame: DepthFrame = match result {
                 Ok(result) => {
                     swept += usize::from(result.method == MatchMethod::PlaneSweep);
+                    if config.sample_pairs.contains(&index) {
+                        samples.push(DepthSample {
+                            pair: index,
+                            truth: render(
+                                &scenario.scene,
+                                result.frame.intrinsics(),
+                                result.frame.world_from_camera(),
+                                seed * 2,
+                                scenario.max_range * 4.0,
+                            ),
+                            frame: result.frame.clone(),
+                        });
+                    }
                     result.frame
                 }
                 Err(_) => {
@@ -192,24 +255,62 @@ pub fn run_experiment(
     seconds.insert("render".into(), render_s);
     seconds.insert("depth_stage".into(), depth_s);
     seconds.insert("integration".into(), integrate_s);
+    let (flight_queries_list, flights) = match &config.flights {
+        Some(flight_config) => {
+            let t = Instant::now();
+            let queries = flight_queries(&scenario.scene, &gold, flight_config)?;
+            let mut flights = vec![(
+                "truth".to_string(),
+                fly(&gold, &scenario.scene, &queries, &flight_config.planner),
+            )];
+            for (name, map) in &maps {
+                flights.push((
+                    name.clone(),
+                    fly(map.as_map(), &scenario.scene, &queries, &flight_config.planner),
+                ));
+            }
+            seconds.insert("flights".into(), t.elapsed().as_secs_f64());
+            (queries, flights)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    let summary_of = |name: &str| {
+        let reference = &flights.first()?.1;
+        let (_, outcomes) = flights.iter().find(|(n, _)| n == name)?;
+        Some(summarize(outcomes, reference))
+    };
     let maps_report = maps
         .iter()
         .map(|(name, map)| {
             let after = phase_metrics.remove(name).unwrap_or_default();
             let metrics = evaluate(map.as_map(), &truth, &scenario.scene);
-            (name.clone(), MapReport { metrics, after })
+            let flights = summary_of(name);
+            (
+                name.clone(),
+                MapReport {
+                    metrics,
+                    after,
+                    flights,
+                },
+            )
         })
         .collect();
-    Ok((
-        ExperimentReport {
-            scenario: scenario.name.to_string(),
-            pairs: scenario.pairs.len(),
-            rejected_pairs: rejected,
-            swept_pairs: swept,
-            maps: maps_report,
-            truth_occupied: truth.occupied_count(),
-            seconds,
-        },
+    let report = ExperimentReport {
+        scenario: scenario.name.to_string(),
+        pairs: scenario.pairs.len(),
+        rejected_pairs: rejected,
+        swept_pairs: swept,
+        maps: maps_report,
+        truth_flights: summary_of("truth"),
+        truth_occupied: truth.occupied_count(),
+        seconds,
+    };
+    Ok(ExperimentOutput {
+        report,
         maps,
-    ))
+        gold: AnyMap::LogOdds(gold),
+        samples,
+        flight_queries: flight_queries_list,
+        flights,
+    })
 }

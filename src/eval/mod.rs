@@ -7,12 +7,25 @@
 //! unknown region (behind walls, in the sky); and the Chamfer distance from occupied voxel
 //! centres to the true surface.
 
+//! [`run_experiment`] feeds identical depth-stage output to every map, measures each after
+//! every phase and, optionally, plans flights in each map and checks them against the true
+//! scene ([`flights`](fly)).
+
 mod experiment;
 mod figures;
+mod flights;
 mod metrics;
+mod report;
 mod truth;
 
-pub use experiment::{ExperimentConfig, ExperimentReport, MapReport, run_experiment};
-pub use figures::top_down_png;
+pub use experiment::{
+    DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport,
+    run_experiment, run_experiment_with_progress,
+};
+pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_image, top_down_png};
+pub use flights::{
+    FlightConfig, FlightOutcome, FlightQuery, FlightSummary, flight_queries, fly, summarize,
+};
 pub use metrics::{MapMetrics, evaluate};
-pub use truth::{GroundTruth, gold_standard};
+pub use report::{file_stem, markdown, write_experiment};
+pub use truth::{GroundTruth, gold_standard, meets_geometry};

@@ -10,7 +10,7 @@
 mod render;
 pub mod scenario;
 mod scene;
-mod texture;
+pub(crate) mod texture;
 pub mod trajectory;
 
 pub use render::{RenderedFrame, render};

@@ -25,6 +25,10 @@ pub struct Scenario {
     pub phases: Vec<(&'static str, std::ops::Range<usize>)>,
     /// Farthest distance the cameras and maps consider, metres.
     pub max_range: f64,
+    /// The x/y box `[[x_min, y_min], [x_max, y_max]]` that figures of the scenario show.
+    pub extent: [[f64; 2]; 2],
+    /// The heights (low, high) that figures colour occupied voxels between.
+    pub heights: [f64; 2],
 }
 
 /// The camera of both scenarios: 320 × 240 pixels, 60° horizontal field of view.
@@ -68,6 +72,8 @@ pub fn wall() -> Result<Scenario> {
         pairs,
         phases: vec![("strafe", 0..6), ("recede", 6..12)],
         max_range: 40.0,
+        extent: [[-8.0, -16.0], [14.0, 16.0]],
+        heights: [0.0, 8.0],
     })
 }
 
@@ -112,6 +118,8 @@ pub fn random(pairs: usize, seed: u64) -> Result<Scenario> {
         phases: vec![("flight", 0..pairs_list.len())],
         pairs: pairs_list,
         max_range: 60.0,
+        extent: [[-65.0, -65.0], [65.0, 65.0]],
+        heights: [0.0, 25.0],
     })
 }
 

@@ -2,7 +2,7 @@ use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d::bounding_volume::Aabb;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 use parry3d::query::Ray;
-use parry3d::shape::{Ball, Cuboid, Cylinder, SharedShape};
+use parry3d::shape::{Ball, Capsule, Cuboid, Cylinder, SharedShape};
 
 /// What a surface is, for texturing and for evaluation (sky has none).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -218,6 +218,20 @@ impl Scene {
         })
     }
 
+    /// Whether a ball of `radius` metres swept along the segment from `a` to `b` (a capsule)
+    /// meets any object: the check of a planned flight against the true geometry.
+    pub fn intersects_swept_ball(&self, a: &Point3<f64>, b: &Point3<f64>, radius: f64) -> bool {
+        let capsule = Capsule::new(a.cast::<f32>(), b.cast::<f32>(), radius.max(0.0) as f32);
+        let identity = Isometry3::identity();
+        let aabb = capsule.aabb(&identity);
+        self.bvh.intersect_aabb(&aabb).any(|leaf| {
+            self.objects.get(leaf as usize).is_some_and(|o| {
+                parry3d::query::intersection_test(&identity, &capsule, &o.pose, &*o.shape)
+                    .unwrap_or(true)
+            })
+        })
+    }
+
     /// Distance from `point` to the nearest surface (0 inside a solid).
     pub fn distance_to_surface(&self, point: &Point3<f64>) -> f64 {
         let p = point.cast::<f32>();
@@ -282,5 +296,20 @@ mod tests {
         assert!(s.intersects_box(&Point3::new(9.7, -0.1, 1.0), &Point3::new(9.85, 0.1, 1.1)));
         assert!(!s.intersects_box(&Point3::new(9.0, -0.1, 1.0), &Point3::new(9.7, 0.1, 1.1)));
         assert!((s.distance_to_surface(&Point3::new(9.0, 0.0, 2.0)) - 0.8).abs() < 1e-4);
+    }
+
+    #[test]
+    fn swept_balls_meet_what_they_pass() {
+        let s = scene();
+        // Along the wall face (x = 9.8) at 0.5 m: clear with a 0.3 m ball, not with 0.6 m.
+        let (a, b) = (Point3::new(9.3, -3.0, 2.0), Point3::new(9.3, 3.0, 2.0));
+        assert!(!s.intersects_swept_ball(&a, &b, 0.3));
+        assert!(s.intersects_swept_ball(&a, &b, 0.6));
+        // Through the wall: always a collision; the trunk (radius 0.2 at (5, 3)) too.
+        assert!(s.intersects_swept_ball(&Point3::new(9.0, 0.0, 2.0), &Point3::new(11.0, 0.0, 2.0), 0.01));
+        assert!(s.intersects_swept_ball(&Point3::new(5.0, 1.0, 1.0), &Point3::new(5.0, 5.0, 1.0), 0.1));
+        assert!(!s.intersects_swept_ball(&Point3::new(4.0, 1.0, 1.0), &Point3::new(4.0, 5.0, 1.0), 0.5));
+        // Down into the ground.
+        assert!(s.intersects_swept_ball(&Point3::new(0.0, 0.0, 1.0), &Point3::new(0.0, 0.0, 0.2), 0.3));
     }
 }

@@ -1,0 +1,281 @@
+//! Planned flights checked against the true scene: random start/goal pairs in truly free space,
+//! a path planned in each map, and every path's segments swept by a ball of the vehicle's radius
+//! against the scene's real geometry.
+
+use nalgebra::Point3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::map::VoxelMap;
+use crate::measures::VoxelClass;
+use crate::plan::{PlannerConfig, plan_path};
+use crate::sim::Scene;
+use crate::sim::texture::unit_hash;
+
+/// How flights are drawn and planned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlightConfig {
+    /// Number of start/goal pairs.
+    pub queries: usize,
+    /// Seed of the draw.
+    pub seed: u64,
+    /// Planner settings (the vehicle radius is also the radius of the collision check).
+    pub planner: PlannerConfig,
+    /// Smallest and largest straight-line distance between start and goal, metres.
+    pub distance: (f64, f64),
+    /// Lowest and highest flight altitude of starts and goals, metres.
+    pub altitude: (f64, f64),
+}
+
+impl Default for FlightConfig {
+    fn default() -> Self {
+        Self {
+            queries: 100,
+            seed: 1,
+            planner: PlannerConfig::default(),
+            distance: (6.0, 25.0),
+            altitude: (1.0, 20.0),
+        }
+    }
+}
+
+/// One start/goal pair.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FlightQuery {
+    /// Start (a voxel centre).
+    pub from: Point3<f64>,
+    /// Goal (a voxel centre).
+    pub to: Point3<f64>,
+}
+
+/// What planning one query in one map gave.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlightOutcome {
+    /// The path's waypoints, when the planner found one.
+    pub waypoints: Option<Vec<Point3<f64>>>,
+    /// Its length in metres.
+    pub length: Option<f64>,
+    /// Whether the path's swept ball meets the true geometry.
+    pub collides: bool,
+}
+
+/// Flight figures of one map, as reported in `metrics.json`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FlightSummary {
+    /// Start/goal pairs tried.
+    pub plan_queries: usize,
+    /// Fraction of them for which the map gave a path.
+    pub plan_success: f64,
+    /// Paths that meet the true geometry.
+    pub plan_collisions: usize,
+    /// Mean of this map's path length over the ground-truth map's, over the queries both
+    /// solved; `None` when there are none.
+    pub path_length_ratio: Option<f64>,
+}
+
+/// Draws start/goal pairs among the voxels that are truly free: free in the gold-standard map,
+/// within the altitude band, and at least the vehicle radius plus a voxel diagonal from every
+/// surface. Deterministic for a seed; fewer pairs come back when too few candidates exist.
+pub fn flight_queries(
+    scene: &Scene,
+    gold: &dyn VoxelMap,
+    config: &FlightConfig,
+) -> Result<Vec<FlightQuery>> {
+    config.planner.validate()?;
+    let (near, far) = config.distance;
+    if !(near.is_finite() && far.is_finite() && near >= 0.0 && far > near) {
+        return Err(Error::InvalidParameter {
+            name: "flight distance range",
+            value: near,
+            expected: "0 <= near < far, finite",
+        });
+    }
+    let resolution = gold.resolution();
+    let margin = config.planner.vehicle_radius + 3f64.sqrt() * resolution.size();
+    let mut candidates: Vec<_> = gold
+        .cells()
+        .filter(|&(key, m)| {
+            let z = resolution.center(key).z;
+            z >= config.altitude.0
+                && z <= config.altitude.1
+                && gold.measure_config().classify(m) == VoxelClass::Free
+        })
+        .map(|(key, _)| key)
+        .collect();
+    candidates.sort_unstable();
+    let candidates: Vec<Point3<f64>> = candidates
+        .par_iter()
+        .map(|&key| resolution.center(key))
+        .filter(|p| scene.distance_to_surface(p) >= margin)
+        .collect();
+    let mut queries = Vec::new();
+    if candidates.len() < 2 {
+        return Ok(queries);
+    }
+    let pick = |n: i64, salt: i64| {
+        let u = unit_hash(n, salt, 97, config.seed);
+        ((u as f64 * candidates.len() as f64) as usize).min(candidates.len() - 1)
+    };
+    let mut draw = 0i64;
+    let attempts = 200 * config.queries as i64 + 1000;
+    while queries.len() < config.queries && draw < attempts {
+        draw += 1;
+        let from = candidates[pick(draw, 1)];
+        let to = candidates[pick(draw, 2)];
+        let d = (to - from).norm();
+        if d >= near && d <= far {
+            queries.push(FlightQuery { from, to });
+        }
+    }
+    Ok(queries)
+}
+
+/// Plans every query in `map` and checks each path against the scene.
+pub fn fly(
+    map: &dyn VoxelMap,
+    scene: &Scene,
+    queries: &[FlightQuery],
+    planner: &PlannerConfig,
+) -> Vec<FlightOutcome> {
+    queries
+        .par_iter()
+        .map(|q| match plan_path(map, &q.from, &q.to, planner) {
+            Ok(path) => {
+                let collides = path.waypoints.windows(2).any(|w| {
+                    scene.intersects_swept_ball(&w[0], &w[1], planner.vehicle_radius)
+                }) || path.waypoints.len() == 1
+                    && scene.intersects_swept_ball(
+                        &path.waypoints[0],
+                        &path.waypoints[0],
+                        planner.vehicle_radius,
+                    );
+                FlightOutcome {
+                    length: Some(path.length),
+                    waypoints: Some(path.waypoints),
+                    collides,
+                }
+            }
+            Err(_) => FlightOutcome {
+                waypoints: None,
+                length: None,
+                collides: false,
+            },
+        })
+        .collect()
+}
+
+/// The figures of one map's outcomes, with lengths compared to the reference (ground-truth
+/// map) outcomes of the same queries.
+pub fn summarize(outcomes: &[FlightOutcome], reference: &[FlightOutcome]) -> FlightSummary {
+    let solved = outcomes.iter().filter(|o| o.length.is_some()).count();
+    let ratios: Vec<f64> = outcomes
+        .iter()
+        .zip(reference)
+        .filter_map(|(o, r)| Some(o.length? / r.length.filter(|l| *l > 0.0)?))
+        .collect();
+    FlightSummary {
+        plan_queries: outcomes.len(),
+        plan_success: if outcomes.is_empty() {
+            0.0
+        } else {
+            solved as f64 / outcomes.len() as f64
+        },
+        plan_collisions: outcomes.iter().filter(|o| o.collides).count(),
+        path_length_ratio: (!ratios.is_empty())
+            .then(|| ratios.iter().sum::<f64>() / ratios.len() as f64),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::{FuzzyConfig, FuzzyMap};
+    use crate::sim::SurfaceKind;
+    use crate::{PointCloud, VoxelMap as _};
+    use nalgebra::Vector3;
+
+    /// A wall at x = 5 across the corridor, mapped from a sensor at the origin, so that the
+    /// map knows the free space in front of the wall.
+    fn wall_world() -> (Scene, FuzzyMap) {
+        let mut scene = Scene::new();
+        scene.add_box(
+            Point3::new(5.3, 0.0, 3.0),
+            Vector3::new(0.3, 6.0, 3.0),
+            0.0,
+            SurfaceKind::Wall,
+        );
+        let mut points = Vec::new();
+        for i in -40..=40 {
+            for j in 0..=40 {
+                points.push(Point3::new(5.0, f64::from(i) * 0.1, f64::from(j) * 0.1 + 1.0));
+            }
+        }
+        let cloud = PointCloud::new(Point3::new(0.0, 0.0, 3.0), points).unwrap();
+        let mut map = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap();
+        for _ in 0..3 {
+            map.integrate_cloud(&cloud, &Default::default()).unwrap();
+        }
+        (scene, map)
+    }
+
+    #[test]
+    fn queries_lie_in_true_free_space_and_repeat_for_a_seed() {
+        let (scene, map) = wall_world();
+        let config = FlightConfig {
+            queries: 10,
+            distance: (1.0, 3.0),
+            altitude: (1.5, 4.0),
+            ..FlightConfig::default()
+        };
+        let a = flight_queries(&scene, &map, &config).unwrap();
+        assert_eq!(a.len(), 10);
+        assert_eq!(a, flight_queries(&scene, &map, &config).unwrap());
+        for q in &a {
+            let d = (q.to - q.from).norm();
+            assert!((1.0..=3.0).contains(&d));
+            for p in [q.from, q.to] {
+                assert!(scene.distance_to_surface(&p) >= 0.3);
+                assert!(p.z >= 1.5 && p.z <= 4.0);
+            }
+        }
+        let other = FlightConfig { seed: 2, ..config };
+        assert_ne!(a, flight_queries(&scene, &map, &other).unwrap());
+    }
+
+    #[test]
+    fn paths_are_checked_against_the_geometry() {
+        let (scene, map) = wall_world();
+        let planner = PlannerConfig::default();
+        let safe = FlightQuery {
+            from: Point3::new(1.1, -1.9, 2.9),
+            to: Point3::new(2.9, 1.9, 3.1),
+        };
+        let outcomes = fly(&map, &scene, &[safe], &planner);
+        assert!(outcomes[0].length.is_some());
+        assert!(!outcomes[0].collides);
+        // The same path judged against a scene with a pillar in its way collides.
+        let mut blocked = scene.clone();
+        blocked.add_box(
+            Point3::new(2.0, 0.0, 3.0),
+            Vector3::new(0.5, 0.5, 3.0),
+            0.0,
+            SurfaceKind::Building,
+        );
+        let judged = fly(&map, &blocked, &[safe], &planner);
+        assert!(judged[0].collides);
+        let summary = summarize(&judged, &outcomes);
+        assert_eq!(summary.plan_queries, 1);
+        assert_eq!(summary.plan_collisions, 1);
+        assert!((summary.plan_success - 1.0).abs() < 1e-12);
+        assert!((summary.path_length_ratio.unwrap() - 1.0).abs() < 1e-12);
+        // A goal inside the wall has no path.
+        let into = FlightQuery {
+            from: safe.from,
+            to: Point3::new(5.3, 0.0, 3.0),
+        };
+        let failed = fly(&map, &scene, &[into], &planner);
+        assert!(failed[0].length.is_none() && !failed[0].collides);
+        assert_eq!(summarize(&failed, &failed).path_length_ratio, None);
+    }
+}
