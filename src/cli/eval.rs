@@ -81,6 +81,8 @@ pub fn experiment_config(
         flights: (plan > 0).then(|| FlightConfig {
             queries: plan,
             seed,
+            altitude: scenario.flight_altitude,
+            distance: scenario.flight_distance,
             ..FlightConfig::default()
         }),
         sample_pairs,

@@ -7,7 +7,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::flights::{FlightConfig, FlightOutcome, FlightQuery, FlightSummary, fly, flight_queries, summarize};
+use super::flights::{
+    FlightConfig, FlightOutcome, FlightQuery, FlightSummary, flight_queries, fly, summarize,
+};
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
 use crate::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, depth_from_pair};
@@ -17,8 +19,8 @@ use crate::map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
 };
 use crate::ops::{Family, TConorm};
-use crate::sim::{RenderedFrame, render};
 use crate::sim::scenario::Scenario;
+use crate::sim::{RenderedFrame, render};
 
 /// Settings of an experiment.
 #[derive(Clone, Debug)]
@@ -266,7 +268,12 @@ pub fn run_experiment_with_progress(
             for (name, map) in &maps {
                 flights.push((
                     name.clone(),
-                    fly(map.as_map(), &scenario.scene, &queries, &flight_config.planner),
+                    fly(
+                        map.as_map(),
+                        &scenario.scene,
+                        &queries,
+                        &flight_config.planner,
+                    ),
                 ));
             }
             seconds.insert("flights".into(), t.elapsed().as_secs_f64());

@@ -13,7 +13,8 @@ use crate::measures::VoxelClass;
 use crate::storage::VoxelKey;
 
 /// The part of the world a top-down view shows: the x/y box `[min, max]` (metres) and the
-/// heights `[low, high]` that the colour ramp spans.
+/// heights `[low, high]` that the colour ramp spans; voxels whose centre lies below `low` (the
+/// ground) are left out.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TopDownView {
     /// South-west corner (x, y), metres.
@@ -29,9 +30,15 @@ const FREE: Rgb<u8> = Rgb([190, 230, 190]);
 /// Colour of columns with no occupied or free voxel.
 const BLANK: Rgb<u8> = Rgb([255, 255, 255]);
 
-/// Draws a top-down view of `map`: each pixel is one voxel column; occupied columns are
-/// coloured by the height of their highest occupied voxel (dark blue low, yellow high); with
-/// `show_free`, columns with free voxels and nothing occupied are light green; the rest white.
+/// Pixels per voxel column of a top-down view: enough for about 600 pixels across.
+fn scale(columns: u32, rows: u32) -> u32 {
+    (600 / columns.max(rows).max(1)).clamp(1, 8)
+}
+
+/// Draws a top-down view of `map`: each voxel column is a square of pixels (about 600 pixels
+/// across in all); occupied columns are coloured by the height of their highest occupied voxel
+/// (dark blue low, yellow high); with `show_free`, columns with free voxels and nothing
+/// occupied are light green; the rest white.
 pub fn top_down_image(map: &dyn VoxelMap, view: &TopDownView, show_free: bool) -> RgbImage {
     let resolution = map.resolution();
     let size = resolution.size();
@@ -43,7 +50,12 @@ pub fn top_down_image(map: &dyn VoxelMap, view: &TopDownView, show_free: bool) -
     let mut free = vec![false; (columns * rows) as usize];
     for (key, m) in map.cells() {
         let (u, v) = (i64::from(key.x) - x0, i64::from(key.y) - y0);
-        if u < 0 || v < 0 || u >= i64::from(columns) || v >= i64::from(rows) {
+        if u < 0
+            || v < 0
+            || u >= i64::from(columns)
+            || v >= i64::from(rows)
+            || resolution.center(key).z < view.heights[0]
+        {
             continue;
         }
         let i = (v as u32 * columns + u as u32) as usize;
@@ -54,8 +66,10 @@ pub fn top_down_image(map: &dyn VoxelMap, view: &TopDownView, show_free: bool) -
         }
     }
     let span = (view.heights[1] - view.heights[0]).max(1e-9);
-    RgbImage::from_fn(columns, rows, |u, v| {
+    let k = scale(columns, rows);
+    RgbImage::from_fn(columns * k, rows * k, |u, v| {
         // Image rows run south to north upwards: flip so that +y is up.
+        let (u, v) = (u / k, v / k);
         let i = ((rows - 1 - v) * columns + u) as usize;
         match top[i] {
             Some(z) => {
@@ -88,13 +102,19 @@ pub fn flights_png(
     path: &Path,
 ) -> Result<()> {
     let mut image = top_down_image(map, view, false);
-    let size = map.resolution().size();
+    // The view's first column starts at the voxel boundary below `view.min`; each column is
+    // `k` pixels wide.
+    let res = map.resolution().size();
+    let columns = ((view.max[0] - view.min[0]) / res)
+        .ceil()
+        .clamp(1.0, 4096.0);
+    let size = res * columns / f64::from(image.width());
+    let (x0, y0) = (
+        (view.min[0] / res).floor() * res,
+        (view.min[1] / res).floor() * res,
+    );
     let rows = f64::from(image.height());
-    let to_pixel = |p: &Point3<f64>| {
-        let u = (p.x - view.min[0]) / size;
-        let v = rows - 1.0 - (p.y - view.min[1]) / size;
-        (u, v)
-    };
+    let to_pixel = |p: &Point3<f64>| ((p.x - x0) / size, rows - (p.y - y0) / size);
     for (waypoints, collides) in paths {
         let colour = if *collides {
             Rgb([220, 30, 30])
@@ -208,19 +228,16 @@ fn put(image: &mut RgbImage, u: f64, v: f64, colour: Rgb<u8>) {
 
 /// A straight line from `a` to `b` (pixels), sampled at half-pixel steps.
 fn line(image: &mut RgbImage, a: (f64, f64), b: (f64, f64), colour: Rgb<u8>) {
-    let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()) * 2.0).ceil().min(1e5) as u32;
+    let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()) * 2.0)
+        .ceil()
+        .min(1e5) as u32;
     for s in 0..=steps {
         let t = if steps == 0 {
             0.0
         } else {
             f64::from(s) / f64::from(steps)
         };
-        put(
-            image,
-            a.0 + (b.0 - a.0) * t,
-            a.1 + (b.1 - a.1) * t,
-            colour,
-        );
+        put(image, a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, colour);
     }
 }
 

@@ -142,14 +142,16 @@ pub fn fly(
         .par_iter()
         .map(|q| match plan_path(map, &q.from, &q.to, planner) {
             Ok(path) => {
-                let collides = path.waypoints.windows(2).any(|w| {
-                    scene.intersects_swept_ball(&w[0], &w[1], planner.vehicle_radius)
-                }) || path.waypoints.len() == 1
-                    && scene.intersects_swept_ball(
-                        &path.waypoints[0],
-                        &path.waypoints[0],
-                        planner.vehicle_radius,
-                    );
+                let collides = path
+                    .waypoints
+                    .windows(2)
+                    .any(|w| scene.intersects_swept_ball(&w[0], &w[1], planner.vehicle_radius))
+                    || path.waypoints.len() == 1
+                        && scene.intersects_swept_ball(
+                            &path.waypoints[0],
+                            &path.waypoints[0],
+                            planner.vehicle_radius,
+                        );
                 FlightOutcome {
                     length: Some(path.length),
                     waypoints: Some(path.waypoints),
@@ -190,9 +192,9 @@ pub fn summarize(outcomes: &[FlightOutcome], reference: &[FlightOutcome]) -> Fli
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::PointCloud;
     use crate::map::{FuzzyConfig, FuzzyMap};
     use crate::sim::SurfaceKind;
-    use crate::{PointCloud, VoxelMap as _};
     use nalgebra::Vector3;
 
     /// A wall at x = 5 across the corridor, mapped from a sensor at the origin, so that the
@@ -208,7 +210,11 @@ mod tests {
         let mut points = Vec::new();
         for i in -40..=40 {
             for j in 0..=40 {
-                points.push(Point3::new(5.0, f64::from(i) * 0.1, f64::from(j) * 0.1 + 1.0));
+                points.push(Point3::new(
+                    5.0,
+                    f64::from(i) * 0.1,
+                    f64::from(j) * 0.1 + 1.0,
+                ));
             }
         }
         let cloud = PointCloud::new(Point3::new(0.0, 0.0, 3.0), points).unwrap();
@@ -248,8 +254,8 @@ mod tests {
         let (scene, map) = wall_world();
         let planner = PlannerConfig::default();
         let safe = FlightQuery {
-            from: Point3::new(1.1, -1.9, 2.9),
-            to: Point3::new(2.9, 1.9, 3.1),
+            from: Point3::new(2.5, -0.8, 3.0),
+            to: Point3::new(4.0, 0.8, 3.0),
         };
         let outcomes = fly(&map, &scene, &[safe], &planner);
         assert!(outcomes[0].length.is_some());
@@ -257,8 +263,8 @@ mod tests {
         // The same path judged against a scene with a pillar in its way collides.
         let mut blocked = scene.clone();
         blocked.add_box(
-            Point3::new(2.0, 0.0, 3.0),
-            Vector3::new(0.5, 0.5, 3.0),
+            Point3::new(3.25, 0.0, 3.0),
+            Vector3::new(0.3, 0.3, 3.0),
             0.0,
             SurfaceKind::Building,
         );

@@ -19,8 +19,8 @@ mod report;
 mod truth;
 
 pub use experiment::{
-    DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport,
-    run_experiment, run_experiment_with_progress,
+    DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport, run_experiment,
+    run_experiment_with_progress,
 };
 pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_image, top_down_png};
 pub use flights::{

@@ -13,7 +13,13 @@ use crate::sim::scenario::Scenario;
 /// File-name form of a map name (`fuzzy:dombi(2)` → `fuzzy_dombi(2)`).
 pub fn file_stem(name: &str) -> String {
     name.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }
 

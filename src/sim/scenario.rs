@@ -27,8 +27,13 @@ pub struct Scenario {
     pub max_range: f64,
     /// The x/y box `[[x_min, y_min], [x_max, y_max]]` that figures of the scenario show.
     pub extent: [[f64; 2]; 2],
-    /// The heights (low, high) that figures colour occupied voxels between.
+    /// The heights (low, high) that figures colour occupied voxels between; top-down figures
+    /// leave out what lies below the low one (the ground).
     pub heights: [f64; 2],
+    /// Altitudes (low, high) of the starts and goals of planned flights, metres.
+    pub flight_altitude: (f64, f64),
+    /// Straight-line distances (shortest, longest) between a flight's start and goal, metres.
+    pub flight_distance: (f64, f64),
 }
 
 /// The camera of both scenarios: 320 × 240 pixels, 60° horizontal field of view.
@@ -72,8 +77,10 @@ pub fn wall() -> Result<Scenario> {
         pairs,
         phases: vec![("strafe", 0..6), ("recede", 6..12)],
         max_range: 40.0,
-        extent: [[-8.0, -16.0], [14.0, 16.0]],
-        heights: [0.0, 8.0],
+        extent: [[-8.0, -16.0], [20.0, 16.0]],
+        heights: [0.3, 8.0],
+        flight_altitude: (0.8, 3.5),
+        flight_distance: (3.0, 15.0),
     })
 }
 
@@ -119,7 +126,9 @@ pub fn random(pairs: usize, seed: u64) -> Result<Scenario> {
         pairs: pairs_list,
         max_range: 60.0,
         extent: [[-65.0, -65.0], [65.0, 65.0]],
-        heights: [0.0, 25.0],
+        heights: [0.3, 25.0],
+        flight_altitude: (1.0, 20.0),
+        flight_distance: (6.0, 25.0),
     })
 }
 

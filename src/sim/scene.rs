@@ -306,10 +306,26 @@ mod tests {
         assert!(!s.intersects_swept_ball(&a, &b, 0.3));
         assert!(s.intersects_swept_ball(&a, &b, 0.6));
         // Through the wall: always a collision; the trunk (radius 0.2 at (5, 3)) too.
-        assert!(s.intersects_swept_ball(&Point3::new(9.0, 0.0, 2.0), &Point3::new(11.0, 0.0, 2.0), 0.01));
-        assert!(s.intersects_swept_ball(&Point3::new(5.0, 1.0, 1.0), &Point3::new(5.0, 5.0, 1.0), 0.1));
-        assert!(!s.intersects_swept_ball(&Point3::new(4.0, 1.0, 1.0), &Point3::new(4.0, 5.0, 1.0), 0.5));
+        assert!(s.intersects_swept_ball(
+            &Point3::new(9.0, 0.0, 2.0),
+            &Point3::new(11.0, 0.0, 2.0),
+            0.01
+        ));
+        assert!(s.intersects_swept_ball(
+            &Point3::new(5.0, 1.0, 1.0),
+            &Point3::new(5.0, 5.0, 1.0),
+            0.1
+        ));
+        assert!(!s.intersects_swept_ball(
+            &Point3::new(4.0, 1.0, 1.0),
+            &Point3::new(4.0, 5.0, 1.0),
+            0.5
+        ));
         // Down into the ground.
-        assert!(s.intersects_swept_ball(&Point3::new(0.0, 0.0, 1.0), &Point3::new(0.0, 0.0, 0.2), 0.3));
+        assert!(s.intersects_swept_ball(
+            &Point3::new(0.0, 0.0, 1.0),
+            &Point3::new(0.0, 0.0, 0.2),
+            0.3
+        ));
     }
 }
