@@ -8,6 +8,7 @@ mod info;
 mod input;
 mod insert;
 mod plan;
+mod simulate;
 mod stereo;
 
 use std::process::ExitCode;
@@ -31,6 +32,7 @@ enum Command {
     Demo(demo::DemoArgs),
     Plan(plan::PlanArgs),
     Stereo(stereo::StereoArgs),
+    Simulate(simulate::SimulateArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -44,6 +46,7 @@ pub fn run() -> ExitCode {
         Command::Demo(args) => demo::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Stereo(args) => stereo::run(args),
+        Command::Simulate(args) => simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,7 +4,6 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use super::flights::{
@@ -186,22 +185,9 @@ pub fn run_experiment_with_progress(
             done += 1;
             progress(done, scenario.pairs.len());
             let t = Instant::now();
-            let seed = config
-                .seed
-                .wrapping_mul(1_000_003)
-                .wrapping_add(index as u64);
-            let views: Vec<_> = [(reference, 0u64), (other, 1)]
-                .par_iter()
-                .map(|(pose, side)| {
-                    render(
-                        &scenario.scene,
-                        &scenario.intrinsics,
-                        pose,
-                        seed * 2 + side,
-                        scenario.max_range * 4.0,
-                    )
-                })
-                .collect();
+            let Some(views) = scenario.render_pair(index, config.seed) else {
+                continue;
+            };
             render_s += t.elapsed().as_secs_f64();
             let frame = |i: usize, pose| -> Result<Frame> {
                 let v = &views[i];
@@ -225,7 +211,7 @@ pub fn run_experiment_with_progress(
                                 &scenario.scene,
                                 result.frame.intrinsics(),
                                 result.frame.world_from_camera(),
-                                seed * 2,
+                                config.seed,
                                 scenario.max_range * 4.0,
                             ),
                             frame: result.frame.clone(),

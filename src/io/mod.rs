@@ -10,6 +10,7 @@ pub mod middlebury;
 pub mod octomap;
 pub mod pfm;
 pub mod rgbd;
+pub mod rgbd_write;
 mod stored_blocks;
 
 pub use atomic::write_atomic;

@@ -7,6 +7,7 @@
 //! Everything is deterministic for a seed: the same scene, camera and seed give the same image
 //! bit for bit, on any number of threads.
 
+pub mod export;
 mod render;
 pub mod scenario;
 mod scene;

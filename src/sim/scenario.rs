@@ -3,6 +3,7 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
+use super::render::{RenderedFrame, render};
 use super::scene::{Scene, SurfaceKind};
 use super::texture::unit_hash;
 use super::trajectory::{look_at, random_flight};
@@ -34,6 +35,26 @@ pub struct Scenario {
     pub flight_altitude: (f64, f64),
     /// Straight-line distances (shortest, longest) between a flight's start and goal, metres.
     pub flight_distance: (f64, f64),
+}
+
+impl Scenario {
+    /// Renders pair `index` (reference view first) with the sensor noise of `seed`: the views
+    /// that the experiment runner and the exported frames share. `None` past the last pair.
+    pub fn render_pair(&self, index: usize, seed: u64) -> Option<[RenderedFrame; 2]> {
+        let (reference, other) = self.pairs.get(index)?;
+        let noise = seed.wrapping_mul(1_000_003).wrapping_add(index as u64);
+        let view = |pose: &Isometry3<f64>, side: u64| {
+            render(
+                &self.scene,
+                &self.intrinsics,
+                pose,
+                noise.wrapping_mul(2).wrapping_add(side),
+                self.max_range * 4.0,
+            )
+        };
+        let (a, b) = rayon::join(|| view(reference, 0), || view(other, 1));
+        Some([a, b])
+    }
 }
 
 /// The camera of both scenarios: 320 × 240 pixels, 60° horizontal field of view.
@@ -85,8 +106,9 @@ pub fn wall() -> Result<Scenario> {
 }
 
 /// The random-flight scenario: 120 m × 120 m of flat ground with buildings (boxes 6–16 m wide,
-/// 5–25 m tall, any heading) and trees, flown over at 4–20 m along random legs, looking in
-/// random directions; each pair is two consecutive poses 0.6 m apart. Deterministic for a seed.
+/// 5–25 m tall, any heading) and trees, flown over at 4–20 m along random legs that keep 1.5 m
+/// from every object, looking in random directions; each pair is two consecutive poses 0.6 m
+/// apart. Deterministic for a seed.
 pub fn random(pairs: usize, seed: u64) -> Result<Scenario> {
     let mut scene = Scene::new();
     scene.add_ground(0.013, 600.0);
@@ -110,12 +132,15 @@ pub fn random(pairs: usize, seed: u64) -> Result<Scenario> {
         let height = uniform(2.0, 5.0);
         scene.add_tree(base, uniform(0.15, 0.4), height, uniform(1.0, 2.5));
     }
+    // Legs keep 1.5 m from every object.
+    let clear = |a: &Point3<f64>, b: &Point3<f64>| !scene.intersects_swept_ball(a, b, 1.5);
     let poses = random_flight(
         seed,
         Point3::new(-45.0, -45.0, 4.0),
         Point3::new(45.0, 45.0, 20.0),
         0.6,
         pairs + 1,
+        &clear,
     );
     let pairs_list: Vec<_> = poses.windows(2).map(|w| (w[1], w[0])).collect();
     Ok(Scenario {
@@ -153,5 +178,13 @@ mod tests {
             b.scene.cast_ray(&origin, &down, 100.0).map(|h| h.distance)
         );
         assert_ne!(random(50, 4).unwrap().pairs, a.pairs);
+        // No camera flies inside or next to an object.
+        for seed in [1, 5] {
+            let s = random(100, seed).unwrap();
+            for (pose, _) in &s.pairs {
+                let p = pose.translation.vector.into();
+                assert!(s.scene.distance_to_surface(&p) >= 1.4, "seed {seed}: {p}");
+            }
+        }
     }
 }

@@ -50,13 +50,16 @@ pub fn recede(
 
 /// A seeded random flight: waypoints uniformly in the box `low`..`high`, flown in straight
 /// legs of `step` metres, looking in a random direction (yaw uniform, pitch between -25° and
-/// 5°) that turns slowly along each leg. Returns at least `count` poses.
+/// 5°) that turns slowly along each leg. `is_clear(a, b)` says whether the straight leg from
+/// `a` to `b` is free to fly (`a == b` for a single point): the start and every waypoint are
+/// drawn again until it holds (up to a thousand times each). Returns `count` poses.
 pub fn random_flight(
     seed: u64,
     low: Point3<f64>,
     high: Point3<f64>,
     step: f64,
     count: usize,
+    is_clear: &dyn Fn(&Point3<f64>, &Point3<f64>) -> bool,
 ) -> Vec<Isometry3<f64>> {
     let mut state = seed;
     let mut uniform = move |lo: f64, hi: f64| {
@@ -64,20 +67,31 @@ pub fn random_flight(
         let h = super::texture::hash3(state as i64, 0, 0, seed);
         lo + (hi - lo) * ((h >> 11) as f64 / (1u64 << 53) as f64)
     };
-    let step = step.max(1e-3);
-    let mut position = Point3::new(
-        uniform(low.x, high.x),
-        uniform(low.y, high.y),
-        uniform(low.z, high.z),
-    );
-    let mut yaw = uniform(0.0, std::f64::consts::TAU);
-    let mut poses = Vec::with_capacity(count);
-    while poses.len() < count {
-        let target = Point3::new(
+    let point = |uniform: &mut dyn FnMut(f64, f64) -> f64| {
+        Point3::new(
             uniform(low.x, high.x),
             uniform(low.y, high.y),
             uniform(low.z, high.z),
-        );
+        )
+    };
+    let step = step.max(1e-3);
+    let mut position = point(&mut uniform);
+    for _ in 0..1000 {
+        if is_clear(&position, &position) {
+            break;
+        }
+        position = point(&mut uniform);
+    }
+    let mut yaw = uniform(0.0, std::f64::consts::TAU);
+    let mut poses = Vec::with_capacity(count);
+    while poses.len() < count {
+        let mut target = point(&mut uniform);
+        for _ in 0..1000 {
+            if is_clear(&position, &target) {
+                break;
+            }
+            target = point(&mut uniform);
+        }
         let (next_yaw, pitch) = (
             uniform(0.0, std::f64::consts::TAU),
             uniform(-25f64.to_radians(), 5f64.to_radians()),
@@ -133,13 +147,17 @@ mod tests {
         assert!((r[2].translation.vector - Vector3::new(-2.0, 0.0, 0.0)).norm() < 1e-12);
         let low = Point3::new(-10.0, -10.0, 2.0);
         let high = Point3::new(10.0, 10.0, 8.0);
-        let a = random_flight(5, low, high, 0.5, 200);
+        let a = random_flight(5, low, high, 0.5, 200, &|_, _| true);
         assert_eq!(a.len(), 200);
-        assert_eq!(a, random_flight(5, low, high, 0.5, 200));
-        assert_ne!(a, random_flight(6, low, high, 0.5, 200));
+        assert_eq!(a, random_flight(5, low, high, 0.5, 200, &|_, _| true));
+        assert_ne!(a, random_flight(6, low, high, 0.5, 200, &|_, _| true));
         for p in &a {
             let t = p.translation.vector;
             assert!(t.x >= -10.0 && t.x <= 10.0 && t.z >= 2.0 && t.z <= 8.0);
         }
+        // Legs that must stay in the half x >= 0 do.
+        let east = |a: &Point3<f64>, b: &Point3<f64>| a.x >= 0.0 && b.x >= 0.0;
+        let kept = random_flight(5, low, high, 0.5, 200, &east);
+        assert!(kept.iter().all(|p| p.translation.vector.x >= 0.0));
     }
 }

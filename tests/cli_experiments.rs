@@ -1,0 +1,165 @@
+//! The experiment commands (`eval`, `simulate`, `demo`), run as a user would.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn fuzzyvox(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
+        .args(args)
+        .output()
+        .expect("running fuzzyvox")
+}
+
+fn json(output: &std::process::Output) -> serde_json::Value {
+    assert!(
+        output.status.success(),
+        "fuzzyvox failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn fails_with(output: &std::process::Output, needle: &str) {
+    assert!(!output.status.success(), "expected a failure");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains(needle), "stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "stderr: {stderr}");
+}
+
+#[test]
+fn eval_wall_reports_every_map_after_each_phase_with_flights_and_figures() {
+    let out = scratch("eval");
+    let report = json(&fuzzyvox(&[
+        "eval",
+        "--scenario",
+        "wall",
+        "--res",
+        "0.25",
+        "--plan",
+        "4",
+        "--ops",
+        "max",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["scenario"], "wall");
+    for name in ["logodds", "alpha", "fuzzy", "fuzzy:minimum"] {
+        let map = &report["maps"][name];
+        for key in [
+            "occupied_precision",
+            "occupied_recall",
+            "occupied_f1",
+            "holes",
+            "spurious_unknown",
+            "chamfer_m",
+            "plan_queries",
+            "plan_success",
+            "plan_collisions",
+            "path_length_ratio",
+        ] {
+            assert!(map.get(key).is_some(), "{name} lacks {key}: {map}");
+        }
+        assert!(map["after_strafe"]["occupied_f1"].is_number(), "{name}");
+        assert_eq!(map["plan_queries"], 4);
+    }
+    for file in [
+        "metrics.json",
+        "report.md",
+        "wall-fuzzy.fvx",
+        "wall-fuzzy.png",
+        "wall-fuzzy-free.png",
+        "wall-logodds-flights.png",
+        "wall-pair0.png",
+        "wall-pair6.png",
+    ] {
+        assert!(out.join(file).is_file(), "missing {file}");
+    }
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("after strafe") && md.contains("![fuzzy](wall-fuzzy.png)"));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn eval_refuses_bad_arguments() {
+    fails_with(
+        &fuzzyvox(&["eval", "--scenario", "random", "--pairs", "0"]),
+        "--pairs",
+    );
+    fails_with(
+        &fuzzyvox(&["eval", "--scenario", "wall", "--ops", "frank:1"]),
+        "--ops",
+    );
+    fails_with(
+        &fuzzyvox(&["eval", "--scenario", "wall", "--res=-1"]),
+        "resolution",
+    );
+    fails_with(&fuzzyvox(&["eval", "--scenario", "moon"]), "moon");
+}
+
+#[test]
+fn simulate_writes_frames_that_read_back_and_the_truth() {
+    let out = scratch("simulate");
+    let summary = json(&fuzzyvox(&[
+        "simulate",
+        "--scenario",
+        "random",
+        "--pairs",
+        "2",
+        "--seed",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(summary["frames"], 4);
+    assert!(summary["truth_occupied"].as_u64().unwrap() > 100);
+    let depth = fuzzyvox::io::rgbd::read_depth_png_mm(&out.join("frame-000003.depth.png")).unwrap();
+    assert_eq!((depth.width, depth.height), (320, 240));
+    assert!(depth.depth.iter().any(|d| *d > 0.0));
+    let pose = fuzzyvox::io::rgbd::read_pose_txt(&out.join("frame-000000.pose.txt")).unwrap();
+    let scenario = fuzzyvox::sim::scenario::random(2, 5).unwrap();
+    let expected = scenario.pairs[0].0.to_homogeneous();
+    assert!((pose.to_homogeneous() - expected).abs().max() < 1e-8);
+    let pairs = std::fs::read_to_string(out.join("pairs.txt")).unwrap();
+    assert!(pairs.contains("0 1 flight") && pairs.contains("2 3 flight"));
+    let info = fuzzyvox(&["info", out.join("gold.fvx").to_str().unwrap()]);
+    assert!(info.status.success());
+    let truth = std::fs::read_to_string(out.join("truth-occupied.xyz")).unwrap();
+    assert_eq!(
+        truth.lines().count() as u64,
+        summary["truth_occupied"].as_u64().unwrap()
+    );
+    // Output under a file is an error with the path, not a panic.
+    let blocker = out.join("pairs.txt");
+    fails_with(
+        &fuzzyvox(&[
+            "simulate",
+            "--scenario",
+            "wall",
+            "--out",
+            blocker.join("inner").to_str().unwrap(),
+        ]),
+        "inner",
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn demo_refuses_an_output_path_that_is_a_file() {
+    let out = scratch("demo");
+    std::fs::create_dir_all(&out).unwrap();
+    let file = out.join("taken");
+    std::fs::write(&file, b"not a folder").unwrap();
+    fails_with(
+        &fuzzyvox(&["demo", "--out", file.to_str().unwrap()]),
+        "taken",
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
