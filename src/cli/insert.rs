@@ -2,11 +2,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
-use fuzzyvox::{
-    AlphaConfig, AlphaCutMap, AnyMap, Family, FuzzyConfig, FuzzyMap, IntegrationOptions,
-    IntegrationStats, LogOddsConfig, LogOddsMap, TConorm,
-};
+use clap::Args;
+use fuzzyvox::{Family, IntegrationOptions, IntegrationStats};
+
+use super::maps::{Model, new_map};
 use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
@@ -51,36 +50,12 @@ pub struct InsertArgs {
     json: bool,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Model {
-    /// The dual-set fuzzy map.
-    Fuzzy,
-    /// The standard log-odds map (OctoMap semantics).
-    Logodds,
-    /// The alpha-cut log-odds map (needs per-point confidence).
-    Alpha,
-}
-
 pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     let family: Family = args.op.parse().context("--op")?;
     if args.model != Model::Fuzzy && args.op != "product" {
         bail!("--op applies to the fuzzy model only");
     }
-    let mut map = match args.model {
-        Model::Fuzzy => AnyMap::Fuzzy(FuzzyMap::new(
-            FuzzyConfig::new(args.res)
-                .context("--res")?
-                .with_operator(TConorm::new(family)?),
-        )?),
-        Model::Logodds => AnyMap::LogOdds(LogOddsMap::new(
-            LogOddsConfig::new(args.res).context("--res")?,
-        )?),
-        Model::Alpha => {
-            let mut config = AlphaConfig::new(args.res).context("--res")?;
-            config.cuts = args.cuts;
-            AnyMap::Alpha(AlphaCutMap::new(config).context("--cuts")?)
-        }
-    };
+    let mut map = new_map(args.model, args.res, family, args.cuts)?;
     let scans = super::input::read_scans(&args.cloud, args.origin)?;
     if args.model == Model::Alpha && scans.iter().any(|s| s.confidence().is_none()) {
         bail!(

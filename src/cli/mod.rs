@@ -7,7 +7,10 @@ mod export;
 mod info;
 mod input;
 mod insert;
+mod maps;
 mod plan;
+pub mod progress;
+mod rgbd;
 mod stereo;
 
 use std::process::ExitCode;
@@ -20,6 +23,9 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Log more to standard error: -v for steps, -vv for details, -vvv for everything.
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    verbose: u8,
 }
 
 #[derive(Subcommand)]
@@ -31,11 +37,13 @@ enum Command {
     Demo(demo::DemoArgs),
     Plan(plan::PlanArgs),
     Stereo(stereo::StereoArgs),
+    Rgbd(rgbd::RgbdArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
+    progress::init_logging(cli.verbose);
     let result = match cli.command {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
@@ -44,6 +52,7 @@ pub fn run() -> ExitCode {
         Command::Demo(args) => demo::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Stereo(args) => stereo::run(args),
+        Command::Rgbd(args) => rgbd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -10,9 +10,11 @@
 mod experiment;
 mod figures;
 mod metrics;
+mod rgbd;
 mod truth;
 
 pub use experiment::{ExperimentConfig, ExperimentReport, MapReport, run_experiment};
 pub use figures::top_down_png;
 pub use metrics::{MapMetrics, evaluate};
+pub use rgbd::{DepthAgreement, DepthCheckConfig, DepthErrors, HoldoutSplit};
 pub use truth::{GroundTruth, gold_standard};
