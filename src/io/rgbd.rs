@@ -187,7 +187,7 @@ impl RgbdFolder {
             });
         }
         if frames.is_empty() {
-            return Err(Error::Empty("RGB-D folder (no frame-N.depth.png)"));
+            return Err(Error::Empty("RGB-D folder (frame-N.depth.png files)"));
         }
         frames.sort_by_key(|f| f.number);
         let intrinsics = dir.join("camera-intrinsics.txt");

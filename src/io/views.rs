@@ -107,8 +107,8 @@ pub fn render_view(
         })
     }) else {
         return Err(Error::Empty(match view {
-            View::Slice { .. } => "slice (no observed voxel at this height)",
-            _ => "map (no observed voxel)",
+            View::Slice { .. } => "map slice at this height",
+            _ => "map",
         }));
     };
     let columns = (i64::from(hi.0) - i64::from(lo.0) + 1) as u64;
