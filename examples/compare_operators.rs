@@ -7,8 +7,6 @@
 //!
 //! Run: `cargo run --release --example compare_operators`
 
-use std::time::Instant;
-
 use fuzzyvox::{
     Family, FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, TConorm, VoxelClass, VoxelMap,
 };
@@ -77,18 +75,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         RESOLUTION
     );
     println!(
-        "| operator | wall found (occupied) | ambiguous on the wall | occupied elsewhere | free | time |"
+        "| operator | wall found (occupied) | ambiguous on the wall | occupied elsewhere | free |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|");
     for name in operators {
         let family: Family = name.parse()?;
         let config = FuzzyConfig::new(RESOLUTION)?.with_operator(TConorm::new(family)?);
         let mut map = FuzzyMap::new(config)?;
-        let started = Instant::now();
         for scan in &scans {
             map.integrate_cloud(scan, &IntegrationOptions::default())?;
         }
-        let seconds = started.elapsed().as_secs_f64();
         // The wall band: voxels within one voxel of the wall plane (the noise spreads the
         // points over it), over the wall's 40 × 20 voxel extent.
         let wall_layer = (WALL_X / RESOLUTION).round() as i32;
@@ -109,10 +105,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let counts = map.counts();
         let wall_found = found.iter().filter(|&&f| f).count() as f64 / found.len() as f64;
         println!(
-            "| `{name}` | {:.1} % | {band_ambiguous} | {elsewhere} | {} | {:.1} ms |",
+            "| `{name}` | {:.1} % | {band_ambiguous} | {elsewhere} | {} |",
             100.0 * wall_found,
             counts.free,
-            seconds * 1e3
         );
     }
     println!(

@@ -329,3 +329,35 @@ fn stereo_matches_a_small_synthetic_pair_and_rejects_mismatched_sizes() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Every command, including ones added later, documents itself with example invocations.
+#[test]
+fn every_command_has_help_with_examples() {
+    let top = fuzzyvox(&["--help"]);
+    assert!(top.status.success());
+    let text = String::from_utf8_lossy(&top.stdout).into_owned();
+    assert!(text.contains("Examples:"), "{text}");
+    let commands: Vec<String> = text
+        .split("Commands:")
+        .nth(1)
+        .expect("a command list")
+        .lines()
+        .skip(1)
+        .take_while(|line| line.starts_with("  "))
+        .filter_map(|line| line.split_whitespace().next().map(str::to_string))
+        .filter(|name| name != "help")
+        .collect();
+    for expected in ["insert", "info", "export", "plan", "stereo", "rgbd"] {
+        assert!(commands.iter().any(|c| c == expected), "{commands:?}");
+    }
+    for command in &commands {
+        let help = fuzzyvox(&[command, "--help"]);
+        let text = String::from_utf8_lossy(&help.stdout);
+        assert!(help.status.success(), "{command}");
+        assert!(
+            text.contains("Examples:\n  fuzzyvox "),
+            "{command} --help:\n{text}"
+        );
+        assert!(text.contains("--verbose"), "{command} takes -v");
+    }
+}

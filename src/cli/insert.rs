@@ -56,7 +56,10 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
         bail!("--op applies to the fuzzy model only");
     }
     let mut map = new_map(args.model, args.res, family, args.cuts)?;
+    let reading = super::progress::spinner("reading the scans", args.json);
     let scans = super::input::read_scans(&args.cloud, args.origin)?;
+    reading.finish_and_clear();
+    tracing::info!("{} scan(s) read from {}", scans.len(), args.cloud.display());
     if args.model == Model::Alpha && scans.iter().any(|s| s.confidence().is_none()) {
         bail!(
             "the alpha model needs a confidence per point, and {} has none: give a text cloud \
@@ -69,6 +72,7 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     };
     let started = Instant::now();
     let mut total = IntegrationStats::default();
+    let bar = super::progress::bar(scans.len() as u64, "integrating", args.json);
     for (index, scan) in scans.iter().enumerate() {
         let stats = map
             .as_map_mut()
@@ -78,12 +82,20 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
         total.skipped += stats.skipped;
         total.clipped += stats.clipped;
         total.voxels_updated += stats.voxels_updated;
+        tracing::debug!(
+            "scan {index}: {} points, {} voxels updated",
+            stats.integrated,
+            stats.voxels_updated
+        );
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     let points: usize = scans.iter().map(|s| s.len()).sum();
     let view = map.as_map();
     let counts = view.counts();
     if let Some(out) = &args.out {
+        tracing::info!("saving {}", out.display());
         map.save(out)
             .with_context(|| format!("saving the map to {}", out.display()))?;
     }

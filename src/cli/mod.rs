@@ -19,7 +19,21 @@ use clap::{Parser, Subcommand};
 
 /// Confidence-aware 3D mapping: dual-set fuzzy voxel maps from uncertain depth.
 #[derive(Parser)]
-#[command(name = "fuzzyvox", version, about, long_about = None)]
+#[command(
+    name = "fuzzyvox",
+    version,
+    about,
+    long_about = None,
+    after_help = "Examples:\n  \
+        fuzzyvox demo\n  \
+        fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
+        fuzzyvox info scan.fvx\n  \
+        fuzzyvox export scan.fvx --png top.png --ply scan.ply --bt scan.bt\n  \
+        fuzzyvox plan --map scan.fvx --from 1,0,0.5 --to 6,3,0.5\n  \
+        fuzzyvox rgbd --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.02\n  \
+        fuzzyvox stereo --middlebury ../shared/data/middlebury-motorcycle --json\n\n\
+        Every command has --help with its own examples; -v, -vv log more to standard error."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -9,7 +9,7 @@ use std::io::{IsTerminal, Write};
 use std::sync::OnceLock;
 use std::time::Duration;
 
-use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressFinish, ProgressStyle};
 use tracing::Level;
 
 /// Every visible bar belongs to this one group, so that log lines can suspend them all.
@@ -52,7 +52,8 @@ impl Write for LogWriter {
 
 /// A progress bar over `total` steps labelled `what`, or a hidden one (every call on it does
 /// nothing) when `quiet` is set (pass the command's `--json`) or standard error is not a
-/// terminal. Call `inc(1)` per step and `finish_and_clear()` at the end.
+/// terminal. Call `inc(1)` per step and `finish_and_clear()` at the end (dropping the bar, e.g.
+/// when an error returns early, clears it too).
 pub fn bar(total: u64, what: &str, quiet: bool) -> ProgressBar {
     if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
@@ -62,7 +63,12 @@ pub fn bar(total: u64, what: &str, quiet: bool) -> ProgressBar {
     )
     .unwrap_or_else(|_| ProgressStyle::default_bar())
     .progress_chars("=> ");
-    let bar = bars().add(ProgressBar::new(total).with_style(style));
+    // Cleared also when dropped early, by an error: the error message then stands alone.
+    let bar = bars().add(
+        ProgressBar::new(total)
+            .with_style(style)
+            .with_finish(ProgressFinish::AndClear),
+    );
     bar.set_message(what.to_string());
     bar.enable_steady_tick(Duration::from_millis(250));
     bar
@@ -75,7 +81,11 @@ pub fn spinner(what: &str, quiet: bool) -> ProgressBar {
     }
     let style = ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
         .unwrap_or_else(|_| ProgressStyle::default_spinner());
-    let spinner = bars().add(ProgressBar::new_spinner().with_style(style));
+    let spinner = bars().add(
+        ProgressBar::new_spinner()
+            .with_style(style)
+            .with_finish(ProgressFinish::AndClear),
+    );
     spinner.set_message(what.to_string());
     spinner.enable_steady_tick(Duration::from_millis(120));
     spinner

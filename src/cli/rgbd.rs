@@ -50,6 +50,10 @@ pub struct RgbdArgs {
     /// Cast rays this far (metres); pixels measured farther are not checked.
     #[arg(long, default_value_t = 8.0, allow_negative_numbers = true)]
     cast_range: f64,
+    /// Let ambiguous voxels stop rays too (by default only occupied voxels do; log-odds maps
+    /// have no ambiguous voxels).
+    #[arg(long)]
+    stop_at_ambiguous: bool,
     /// Aggregation t-conorm of the fuzzy model as NAME[:PARAM] (see `insert --help`).
     #[arg(long, default_value = "product")]
     op: String,
@@ -101,6 +105,7 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
     let check = DepthCheckConfig {
         pixel_step: args.pixel_step,
         max_range: args.cast_range,
+        stop_at_ambiguous: args.stop_at_ambiguous,
     }
     .validate()
     .context("--pixel-step / --cast-range")?;
@@ -210,7 +215,10 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
                 "predicted_pixels": summary.predicted_pixels,
                 "predicted": summary.predicted,
                 "median_abs_depth_error_m": summary.median_abs_depth_error_m,
+                "median_depth_error_m": summary.median_depth_error_m,
                 "within_2_voxels": summary.within_2_voxels,
+                "too_near": summary.too_near,
+                "too_far": summary.too_far,
             })
         })
         .collect();
@@ -224,6 +232,7 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
             "resolution": args.res,
             "pixel_step": args.pixel_step,
             "cast_range": args.cast_range,
+            "stop_at_ambiguous": args.stop_at_ambiguous,
             "maps": reports,
         }));
     }
@@ -237,18 +246,28 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
         args.holdout
     );
     println!(
-        "{:<8} {:>10} {:>10} {:>10} {:>15} {:>10} {:>10}",
-        "model", "build s", "predict s", "predicted", "median error m", "within 2v", "occupied"
+        "{:<8} {:>8} {:>10} {:>10} {:>15} {:>10} {:>9} {:>9} {:>9}",
+        "model",
+        "build s",
+        "predict s",
+        "predicted",
+        "median error m",
+        "within 2v",
+        "too near",
+        "too far",
+        "occupied"
     );
     for r in &reports {
         println!(
-            "{:<8} {:>10.2} {:>10.2} {:>10.3} {:>15.4} {:>10.3} {:>10}",
+            "{:<8} {:>8.2} {:>10.2} {:>10.3} {:>15.4} {:>10.3} {:>9.3} {:>9.3} {:>9}",
             r["model"].as_str().unwrap_or("?"),
             r["build_seconds"].as_f64().unwrap_or(f64::NAN),
             r["predict_seconds"].as_f64().unwrap_or(f64::NAN),
             r["predicted"].as_f64().unwrap_or(f64::NAN),
             r["median_abs_depth_error_m"].as_f64().unwrap_or(f64::NAN),
             r["within_2_voxels"].as_f64().unwrap_or(f64::NAN),
+            r["too_near"].as_f64().unwrap_or(f64::NAN),
+            r["too_far"].as_f64().unwrap_or(f64::NAN),
             r["occupied"].as_u64().unwrap_or(0),
         );
     }

@@ -61,6 +61,10 @@ pub struct DepthCheckConfig {
     pub pixel_step: u32,
     /// Rays are cast this far (metres along the ray); farther surfaces are not predicted.
     pub max_range: f64,
+    /// Whether ambiguous voxels (both sets claim them) stop a ray as occupied ones do. Off by
+    /// default: a ray stops at the first `Occupied` voxel, the class a planner treats as an
+    /// obstacle in every map.
+    pub stop_at_ambiguous: bool,
 }
 
 impl Default for DepthCheckConfig {
@@ -68,6 +72,7 @@ impl Default for DepthCheckConfig {
         Self {
             pixel_step: 1,
             max_range: 8.0,
+            stop_at_ambiguous: false,
         }
     }
 }
@@ -99,8 +104,9 @@ impl DepthCheckConfig {
 pub struct DepthErrors {
     /// Pixels with a measured depth (up to the cast range) that were checked.
     pub valid_pixels: usize,
-    /// `|predicted - measured|` depth along the optical axis (metres) of every valid pixel
-    /// whose ray met an occupied voxel.
+    /// `predicted - measured` depth along the optical axis (metres) of every valid pixel
+    /// whose ray met an occupied voxel, in pixel order: negative where the map stops the ray
+    /// in front of the measured surface.
     pub errors: Vec<f32>,
 }
 
@@ -125,6 +131,11 @@ impl DepthErrors {
         let width = image.width() as usize;
         let step = config.pixel_step as usize;
         let origin = pose.translation.vector.into();
+        let stop_at: &[VoxelClass] = if config.stop_at_ambiguous {
+            &[VoxelClass::Occupied, VoxelClass::Ambiguous]
+        } else {
+            &[VoxelClass::Occupied]
+        };
         let pixels: Vec<usize> = (0..image.height() as usize)
             .step_by(step)
             .flat_map(|v| (0..width).step_by(step).map(move |u| v * width + u))
@@ -146,16 +157,8 @@ impl DepthErrors {
                     return Ok(None);
                 }
                 let direction = pose.rotation * in_camera;
-                let hit = cast_ray(
-                    map,
-                    &origin,
-                    &direction,
-                    config.max_range,
-                    &[VoxelClass::Occupied],
-                )?;
-                Ok(Some(
-                    hit.map(|h| (h.distance() / scale - measured).abs() as f32),
-                ))
+                let hit = cast_ray(map, &origin, &direction, config.max_range, stop_at)?;
+                Ok(Some(hit.map(|h| (h.distance() / scale - measured) as f32)))
             })
             .collect();
         // Validate everything before changing the accumulator.
@@ -169,19 +172,13 @@ impl DepthErrors {
 
     /// The summary at a map resolution of `resolution` metres.
     pub fn summary(&self, resolution: f64) -> DepthAgreement {
-        let mut sorted = self.errors.clone();
-        sorted.sort_by(f32::total_cmp);
-        let median = match sorted.len() {
-            0 => f64::NAN,
-            n if n % 2 == 1 => f64::from(sorted[n / 2]),
-            n => 0.5 * (f64::from(sorted[n / 2 - 1]) + f64::from(sorted[n / 2])),
-        };
         let tolerance = 2.0 * resolution;
-        let within = self
-            .errors
-            .iter()
-            .filter(|&&e| f64::from(e) <= tolerance)
-            .count();
+        let count = |keep: &dyn Fn(f64) -> bool| {
+            self.errors.iter().filter(|&&e| keep(f64::from(e))).count()
+        };
+        let within = count(&|e| e.abs() <= tolerance);
+        let near = count(&|e| e < -tolerance);
+        let far = count(&|e| e > tolerance);
         let fraction = |n: usize| {
             if self.valid_pixels == 0 {
                 f64::NAN
@@ -193,9 +190,22 @@ impl DepthErrors {
             valid_pixels: self.valid_pixels,
             predicted_pixels: self.errors.len(),
             predicted: fraction(self.errors.len()),
-            median_abs_depth_error_m: median,
+            median_abs_depth_error_m: median(self.errors.iter().map(|e| e.abs()).collect()),
+            median_depth_error_m: median(self.errors.clone()),
             within_2_voxels: fraction(within),
+            too_near: fraction(near),
+            too_far: fraction(far),
         }
+    }
+}
+
+/// The median of `values` (NaN when empty).
+fn median(mut values: Vec<f32>) -> f64 {
+    values.sort_by(f32::total_cmp);
+    match values.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => f64::from(values[n / 2]),
+        n => 0.5 * (f64::from(values[n / 2 - 1]) + f64::from(values[n / 2])),
     }
 }
 
@@ -211,9 +221,18 @@ pub struct DepthAgreement {
     /// Median of `|predicted - measured|` depth over the predicted pixels (metres; NaN when
     /// none).
     pub median_abs_depth_error_m: f64,
+    /// Median of `predicted - measured` over the predicted pixels (metres; negative: the map
+    /// stops rays in front of the surfaces).
+    pub median_depth_error_m: f64,
     /// Fraction of the valid pixels (predicted or not) whose predicted depth lies within two
     /// voxels of the measured depth: a pixel the map predicts nothing for counts as a miss.
     pub within_2_voxels: f64,
+    /// Fraction of the valid pixels predicted more than two voxels too near (the ray stopped at
+    /// a spurious or thickened surface).
+    pub too_near: f64,
+    /// Fraction predicted more than two voxels too far (the ray passed through the surface: an
+    /// eroded or missing wall).
+    pub too_far: f64,
 }
 
 #[cfg(test)]
@@ -227,13 +246,18 @@ mod tests {
 
     /// A camera at `x` metres left of the origin looking along +z at a wall at z = 2 m.
     fn wall_frame(x: f64) -> DepthFrame {
+        wall_frame_at(x, 2.0)
+    }
+
+    /// The same camera measuring a wall at `depth` metres.
+    fn wall_frame_at(x: f64, depth: f32) -> DepthFrame {
         let k = PinholeIntrinsics::new(64, 48, 50.0, 50.0, 31.5, 23.5).unwrap();
         let pose =
             Isometry3::from_parts(Translation3::new(x, 0.0, 0.0), UnitQuaternion::identity());
         let depth = crate::io::rgbd::DepthImage {
             width: 64,
             height: 48,
-            depth: vec![2.0; 64 * 48],
+            depth: vec![depth; 64 * 48],
         };
         DepthFrame::new(k, pose, kinect_interval_image(&depth).unwrap()).unwrap()
     }
@@ -263,6 +287,20 @@ mod tests {
         assert!(summary.predicted > 0.95, "{summary:?}");
         assert!(summary.within_2_voxels > 0.95, "{summary:?}");
         assert!(summary.median_abs_depth_error_m < 0.05, "{summary:?}");
+        let parts = summary.within_2_voxels + summary.too_near + summary.too_far;
+        assert!((parts - summary.predicted).abs() < 1e-12, "{summary:?}");
+        // A frame that measures the wall 0.5 m farther: the map stops every ray too near.
+        let mut farther = DepthErrors::default();
+        farther
+            .add_frame(&map, &wall_frame_at(0.0, 2.5), &DepthCheckConfig::default())
+            .unwrap();
+        let summary = farther.summary(0.05);
+        assert!(summary.too_near > 0.95, "{summary:?}");
+        assert!(
+            (summary.median_depth_error_m + 0.5).abs() < 0.05,
+            "{summary:?}"
+        );
+        assert_eq!(summary.too_far, 0.0);
     }
 
     #[test]
@@ -272,6 +310,7 @@ mod tests {
         let config = DepthCheckConfig {
             pixel_step: 4,
             max_range: 5.0,
+            ..DepthCheckConfig::default()
         };
         errors.add_frame(&map, &wall_frame(0.0), &config).unwrap();
         let summary = errors.summary(0.05);
@@ -288,17 +327,18 @@ mod tests {
         let short = DepthCheckConfig {
             pixel_step: 1,
             max_range: 1.0,
+            ..DepthCheckConfig::default()
         };
         errors.add_frame(&map, &wall_frame(0.0), &short).unwrap();
         assert_eq!(errors.valid_pixels, 0);
         for bad in [
             DepthCheckConfig {
                 pixel_step: 0,
-                max_range: 1.0,
+                ..DepthCheckConfig::default()
             },
             DepthCheckConfig {
-                pixel_step: 1,
                 max_range: f64::NAN,
+                ..DepthCheckConfig::default()
             },
         ] {
             assert!(errors.add_frame(&map, &wall_frame(0.0), &bad).is_err());
