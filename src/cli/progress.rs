@@ -4,6 +4,23 @@
 //! and errors always). Progress bars come from [`bar`] and are hidden when standard error is not
 //! a terminal or when the command prints JSON, so scripts and pipes see clean output. While a
 //! bar is drawn, log lines are printed above it instead of through it.
+//!
+//! In a command (`run(args)`), with `args.json` its `--json` flag:
+//!
+//! ```text
+//! let bar = super::progress::bar(pairs.len() as u64, "matching", args.json);
+//! for pair in &pairs {
+//!     // ... the work ...
+//!     tracing::debug!("pair {}: {} pixels", pair.id, pixels); // shown with -vv
+//!     bar.inc(1);
+//! }
+//! bar.finish_and_clear();
+//! tracing::info!("{} pairs matched", pairs.len()); // shown with -v
+//! ```
+//!
+//! `spinner(what, args.json)` does the same for one step of unknown length (loading a map);
+//! change its label with `set_message` between steps. `init_logging` is called once, in
+//! `cli::run`, from the global `-v` count.
 
 use std::io::{IsTerminal, Write};
 use std::sync::OnceLock;
