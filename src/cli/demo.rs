@@ -4,11 +4,11 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::eval::{file_stem, run_experiment, write_experiment};
+use fuzzyvox::eval::{file_stem, write_experiment};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::sim::scenario;
 
-use super::eval::experiment_config;
+use super::eval::{experiment_config, run_with_bar};
 
 /// The simulated flight demo: a drone's camera maps the paper's two scenes (a wall, then a
 /// random flight over buildings and trees) with the standard log-odds map, the alpha-cut map
@@ -49,7 +49,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             scenario.pairs.len()
         );
         let config = experiment_config(&scenario, 0.2, Vec::new(), 1, flights);
-        let output = run_experiment(&scenario, &config)?;
+        let output = run_with_bar(&scenario, &config, false)?;
         let (section, _) = write_experiment(&args.out, &scenario, &output)?;
         report.push_str(&section);
         for (name, map) in &output.maps {

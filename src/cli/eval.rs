@@ -4,7 +4,9 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use fuzzyvox::Family;
-use fuzzyvox::eval::{ExperimentConfig, FlightConfig, run_experiment, write_experiment};
+use fuzzyvox::eval::{
+    ExperimentConfig, FlightConfig, run_experiment_with_progress, write_experiment,
+};
 use fuzzyvox::sim::scenario::{self, Scenario};
 
 /// Run one of the paper's scenarios: render every stereo pair, run the depth stage, feed the
@@ -90,6 +92,25 @@ pub fn experiment_config(
     }
 }
 
+/// Runs an experiment with a progress bar over its pairs (hidden for JSON or without a
+/// terminal), logging the phase timings with `-v`.
+pub fn run_with_bar(
+    scenario: &Scenario,
+    config: &ExperimentConfig,
+    json: bool,
+) -> anyhow::Result<fuzzyvox::eval::ExperimentOutput> {
+    let label = format!("{} scenario", scenario.name);
+    let bar = super::progress::bar(scenario.pairs.len() as u64, &label, json);
+    let output = run_experiment_with_progress(scenario, config, &mut |done, _| {
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    for (stage, seconds) in &output.report.seconds {
+        tracing::info!("{}: {stage} {seconds:.1} s", scenario.name);
+    }
+    Ok(output)
+}
+
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     if args.pairs == 0 {
         anyhow::bail!("--pairs must be at least 1");
@@ -102,7 +123,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let scenario = args.scenario.build(args.pairs, args.seed)?;
     let config = experiment_config(&scenario, args.res, operators, args.seed, args.plan);
     let started = Instant::now();
-    let output = run_experiment(&scenario, &config)?;
+    let output = run_with_bar(&scenario, &config, args.json)?;
     let seconds = started.elapsed().as_secs_f64();
     let report = &output.report;
     if let Some(dir) = &args.out {

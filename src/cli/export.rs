@@ -1,50 +1,207 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use clap::Args;
-use fuzzyvox::AnyMap;
+use clap::{Args, ValueEnum};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
-use serde_json::json;
+use fuzzyvox::io::ply::{PlyEncoding, write_ply};
+use fuzzyvox::io::views::{View, ViewColor, write_view_png};
+use fuzzyvox::{AnyMap, VoxelClass};
+use serde_json::{Value, json};
+use tracing::info;
 
-/// Export a saved map to other tools' formats.
+use super::progress;
+
+/// Export a saved map to other tools' formats: OctoMap `.bt`, PLY points, PNG views.
 ///
 /// `--bt` writes an OctoMap binary octree (`.bt`, maximum likelihood) that OctoMap's tools and
 /// octovis open: every observed voxel becomes occupied when its occupied membership is at least
 /// its free membership (for a log-odds map: p ≥ 0.5, OctoMap's own rule) and free otherwise;
 /// voxels nothing observed stay unknown.
+///
+/// `--ply` writes one vertex per observed voxel centre (of the `--classes` chosen) with its
+/// occupied and free memberships, ambiguity, safety, class (0 occupied, 1 free, 2 ambiguous,
+/// 3 unknown) and a class colour; binary little-endian unless `--ascii`.
+///
+/// `--png` draws the map from the top (x right, y up), from the side (x right, z up) or as the
+/// horizontal slice at `--height`, one pixel per voxel times `--scale`, coloured by class or by
+/// one measure. Projections show per column the most critical class, the largest membership or
+/// ambiguity, or the smallest safety.
+///
+/// Several outputs can be written in one call.
 #[derive(Args)]
-#[command(
-    after_help = "Examples:\n  fuzzyvox export scan.fvx --bt scan.bt\n  fuzzyvox export scan.fvx --bt scan.bt --json"
-)]
+#[command(after_help = "Examples:\n  \
+    fuzzyvox export scan.fvx --bt scan.bt\n  \
+    fuzzyvox export scan.fvx --ply scan.ply --classes occupied,ambiguous\n  \
+    fuzzyvox export scan.fvx --ply scan.ply --ascii --json\n  \
+    fuzzyvox export scan.fvx --png top.png\n  \
+    fuzzyvox export scan.fvx --png side.png --view side --color occupied --scale 4\n  \
+    fuzzyvox export scan.fvx --png slice.png --view slice --height 1.2 --color safety")]
+#[command(group(clap::ArgGroup::new("output").required(true).multiple(true).args(["bt", "ply", "png"])))]
 pub struct ExportArgs {
-    /// A map file written by `fuzzyvox insert --out`.
+    /// A map file written by `fuzzyvox insert --out` (or `rgbd --save`).
     map: PathBuf,
     /// Write an OctoMap `.bt` file here.
     #[arg(long)]
     bt: Option<PathBuf>,
+    /// Write a PLY point file of voxel centres here.
+    #[arg(long)]
+    ply: Option<PathBuf>,
+    /// Write the PLY as text instead of binary little-endian.
+    #[arg(long, requires = "ply")]
+    ascii: bool,
+    /// Classes of the voxels in the PLY file, comma-separated (default: every observed voxel).
+    #[arg(long, value_enum, value_delimiter = ',', requires = "ply")]
+    classes: Vec<ClassArg>,
+    /// Write a PNG view here.
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Which view the PNG shows.
+    #[arg(long, value_enum, default_value_t = ViewArg::Top, requires = "png")]
+    view: ViewArg,
+    /// Height of the slice in metres (with `--view slice`).
+    #[arg(long, allow_negative_numbers = true, requires = "png")]
+    height: Option<f64>,
+    /// What colours the PNG.
+    #[arg(long, value_enum, default_value_t = ColorArg::Class, requires = "png")]
+    color: ColorArg,
+    /// Pixels per voxel in the PNG (1 to 16).
+    #[arg(long, default_value_t = 1, requires = "png")]
+    scale: u32,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ClassArg {
+    Occupied,
+    Free,
+    Ambiguous,
+    Unknown,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ViewArg {
+    Top,
+    Side,
+    Slice,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ColorArg {
+    Class,
+    Occupied,
+    Free,
+    Ambiguity,
+    Safety,
+}
+
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
-    let Some(bt) = &args.bt else {
-        bail!("nothing to export: give --bt OUT.bt");
+    let view = match (args.view, args.height) {
+        (ViewArg::Slice, Some(z)) => View::Slice { z },
+        (ViewArg::Slice, None) => bail!("--view slice needs --height Z (metres)"),
+        (_, Some(_)) => bail!("--height applies to --view slice only"),
+        (ViewArg::Top, None) => View::Top,
+        (ViewArg::Side, None) => View::Side,
     };
-    let map = AnyMap::load(&args.map)?;
-    let (occupied, free) = write_bt_max_likelihood(bt, map.as_map())
-        .with_context(|| format!("writing {}", bt.display()))?;
-    if args.json {
-        return super::print_json(&json!({
-            "map": args.map,
-            "bt": bt,
-            "occupied": occupied,
-            "free": free,
-        }));
+    let spinner = progress::spinner("loading the map", args.json);
+    let map = AnyMap::load(&args.map)
+        .with_context(|| format!("loading the map {}", args.map.display()))?;
+    let mut report = json!({ "map": args.map, "model": map.kind().name() });
+    let mut lines = Vec::new();
+
+    if let Some(bt) = &args.bt {
+        spinner.set_message("writing the .bt file");
+        let (occupied, free) = write_bt_max_likelihood(bt, map.as_map())
+            .with_context(|| format!("writing {}", bt.display()))?;
+        info!("wrote {}", bt.display());
+        report["bt"] = json!(bt);
+        report["occupied"] = json!(occupied);
+        report["free"] = json!(free);
+        lines.push(format!(
+            "wrote {} ({occupied} occupied and {free} free voxels, maximum likelihood)",
+            bt.display()
+        ));
     }
-    println!(
-        "wrote {} ({occupied} occupied and {free} free voxels, maximum likelihood)",
-        bt.display()
-    );
+    if let Some(ply) = &args.ply {
+        spinner.set_message("writing the PLY file");
+        let classes: Vec<VoxelClass> = if args.classes.is_empty() {
+            VoxelClass::ALL.to_vec()
+        } else {
+            args.classes
+                .iter()
+                .map(|c| match c {
+                    ClassArg::Occupied => VoxelClass::Occupied,
+                    ClassArg::Free => VoxelClass::Free,
+                    ClassArg::Ambiguous => VoxelClass::Ambiguous,
+                    ClassArg::Unknown => VoxelClass::Unknown,
+                })
+                .collect()
+        };
+        let encoding = if args.ascii {
+            PlyEncoding::Ascii
+        } else {
+            PlyEncoding::BinaryLittleEndian
+        };
+        let vertices = write_ply(map.as_map(), &classes, encoding, ply)
+            .with_context(|| format!("writing {}", ply.display()))?;
+        info!("wrote {}", ply.display());
+        report["ply"] = json!(ply);
+        report["ply_vertices"] = json!(vertices);
+        report["ply_format"] = json!(if args.ascii {
+            "ascii"
+        } else {
+            "binary_little_endian"
+        });
+        let names: Vec<&str> = classes.iter().map(|c| c.name()).collect();
+        lines.push(format!(
+            "wrote {} ({vertices} voxels: {})",
+            ply.display(),
+            names.join(", ")
+        ));
+    }
+    if let Some(png) = &args.png {
+        spinner.set_message("drawing the PNG view");
+        let color = match args.color {
+            ColorArg::Class => ViewColor::Class,
+            ColorArg::Occupied => ViewColor::Occupied,
+            ColorArg::Free => ViewColor::Free,
+            ColorArg::Ambiguity => ViewColor::Ambiguity,
+            ColorArg::Safety => ViewColor::Safety,
+        };
+        let (width, height) = write_view_png(map.as_map(), view, color, args.scale, png)
+            .with_context(|| format!("writing {}", png.display()))?;
+        info!("wrote {}", png.display());
+        let view_name = match view {
+            View::Top => "top",
+            View::Side => "side",
+            View::Slice { .. } => "slice",
+        };
+        let color_name = args
+            .color
+            .to_possible_value()
+            .map(|v| v.get_name().to_string())
+            .unwrap_or_default();
+        report["png"] = json!(png);
+        report["png_width"] = json!(width);
+        report["png_height"] = json!(height);
+        report["view"] = json!(view_name);
+        report["color"] = json!(color_name);
+        report["slice_height"] = match view {
+            View::Slice { z } => json!(z),
+            _ => Value::Null,
+        };
+        lines.push(format!(
+            "wrote {} ({width} × {height} pixels, {view_name} view by {color_name})",
+            png.display()
+        ));
+    }
+    spinner.finish_and_clear();
+    if args.json {
+        return super::print_json(&report);
+    }
+    for line in lines {
+        println!("{line}");
+    }
     Ok(())
 }

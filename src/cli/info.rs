@@ -17,8 +17,10 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
+    let loading = super::progress::spinner("loading the map", args.json);
     let header = read_header(&args.map)?;
     let map = AnyMap::load(&args.map)?;
+    loading.finish_and_clear();
     let view = map.as_map();
     let counts = view.counts();
     let resolution = view.resolution();

@@ -2,11 +2,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
-use fuzzyvox::{
-    AlphaConfig, AlphaCutMap, AnyMap, Family, FuzzyConfig, FuzzyMap, IntegrationOptions,
-    IntegrationStats, LogOddsConfig, LogOddsMap, TConorm,
-};
+use clap::Args;
+use fuzzyvox::{Family, IntegrationOptions, IntegrationStats};
+
+use super::maps::{Model, new_map};
 use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
@@ -51,37 +50,16 @@ pub struct InsertArgs {
     json: bool,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Model {
-    /// The dual-set fuzzy map.
-    Fuzzy,
-    /// The standard log-odds map (OctoMap semantics).
-    Logodds,
-    /// The alpha-cut log-odds map (needs per-point confidence).
-    Alpha,
-}
-
 pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     let family: Family = args.op.parse().context("--op")?;
     if args.model != Model::Fuzzy && args.op != "product" {
         bail!("--op applies to the fuzzy model only");
     }
-    let mut map = match args.model {
-        Model::Fuzzy => AnyMap::Fuzzy(FuzzyMap::new(
-            FuzzyConfig::new(args.res)
-                .context("--res")?
-                .with_operator(TConorm::new(family)?),
-        )?),
-        Model::Logodds => AnyMap::LogOdds(LogOddsMap::new(
-            LogOddsConfig::new(args.res).context("--res")?,
-        )?),
-        Model::Alpha => {
-            let mut config = AlphaConfig::new(args.res).context("--res")?;
-            config.cuts = args.cuts;
-            AnyMap::Alpha(AlphaCutMap::new(config).context("--cuts")?)
-        }
-    };
+    let mut map = new_map(args.model, args.res, family, args.cuts)?;
+    let reading = super::progress::spinner("reading the scans", args.json);
     let scans = super::input::read_scans(&args.cloud, args.origin)?;
+    reading.finish_and_clear();
+    tracing::info!("{} scan(s) read from {}", scans.len(), args.cloud.display());
     if args.model == Model::Alpha && scans.iter().any(|s| s.confidence().is_none()) {
         bail!(
             "the alpha model needs a confidence per point, and {} has none: give a text cloud \
@@ -94,6 +72,7 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     };
     let started = Instant::now();
     let mut total = IntegrationStats::default();
+    let bar = super::progress::bar(scans.len() as u64, "integrating", args.json);
     for (index, scan) in scans.iter().enumerate() {
         let stats = map
             .as_map_mut()
@@ -103,12 +82,20 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
         total.skipped += stats.skipped;
         total.clipped += stats.clipped;
         total.voxels_updated += stats.voxels_updated;
+        tracing::debug!(
+            "scan {index}: {} points, {} voxels updated",
+            stats.integrated,
+            stats.voxels_updated
+        );
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     let points: usize = scans.iter().map(|s| s.len()).sum();
     let view = map.as_map();
     let counts = view.counts();
     if let Some(out) = &args.out {
+        tracing::info!("saving {}", out.display());
         map.save(out)
             .with_context(|| format!("saving the map to {}", out.display()))?;
     }

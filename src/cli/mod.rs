@@ -7,7 +7,10 @@ mod export;
 mod info;
 mod input;
 mod insert;
+mod maps;
 mod plan;
+pub mod progress;
+mod rgbd;
 mod simulate;
 mod stereo;
 
@@ -17,10 +20,27 @@ use clap::{Parser, Subcommand};
 
 /// Confidence-aware 3D mapping: dual-set fuzzy voxel maps from uncertain depth.
 #[derive(Parser)]
-#[command(name = "fuzzyvox", version, about, long_about = None)]
+#[command(
+    name = "fuzzyvox",
+    version,
+    about,
+    long_about = None,
+    after_help = "Examples:\n  \
+        fuzzyvox demo\n  \
+        fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
+        fuzzyvox info scan.fvx\n  \
+        fuzzyvox export scan.fvx --png top.png --ply scan.ply --bt scan.bt\n  \
+        fuzzyvox plan --map scan.fvx --from 1,0,0.5 --to 6,3,0.5\n  \
+        fuzzyvox rgbd --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.02\n  \
+        fuzzyvox stereo --middlebury ../shared/data/middlebury-motorcycle --json\n\n\
+        Every command has --help with its own examples; -v, -vv log more to standard error."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Log more to standard error: -v for steps, -vv for details, -vvv for everything.
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    verbose: u8,
 }
 
 #[derive(Subcommand)]
@@ -33,11 +53,13 @@ enum Command {
     Plan(plan::PlanArgs),
     Stereo(stereo::StereoArgs),
     Simulate(simulate::SimulateArgs),
+    Rgbd(rgbd::RgbdArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
+    progress::init_logging(cli.verbose);
     let result = match cli.command {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
@@ -47,6 +69,7 @@ pub fn run() -> ExitCode {
         Command::Plan(args) => plan::run(args),
         Command::Stereo(args) => stereo::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Rgbd(args) => rgbd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

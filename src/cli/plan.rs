@@ -50,7 +50,15 @@ enum Unknown {
 }
 
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
+    let spinner = super::progress::spinner("loading the map", args.json);
     let map = AnyMap::load(&args.map)?;
+    tracing::info!(
+        "{} map at {} m loaded from {}",
+        map.kind().name(),
+        map.as_map().resolution().size(),
+        args.map.display()
+    );
+    spinner.set_message("planning");
     let config = PlannerConfig {
         vehicle_radius: args.radius,
         safety_threshold: args.safety,
@@ -63,6 +71,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let path = plan_path(map.as_map(), &args.from, &args.to, &config)?;
     let seconds = started.elapsed().as_secs_f64();
+    spinner.finish_and_clear();
     if args.json {
         let waypoints: Vec<[f64; 3]> = path.waypoints.iter().map(|p| [p.x, p.y, p.z]).collect();
         return super::print_json(&json!({

@@ -46,8 +46,13 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let scenario = args.scenario.build(args.pairs, args.seed)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let frames = write_frames(&args.out, &scenario, args.seed, &mut |_, _| {})
-        .with_context(|| format!("writing frames to {}", args.out.display()))?;
+    let bar = super::progress::bar(scenario.pairs.len() as u64, "rendering", args.json);
+    let frames = write_frames(&args.out, &scenario, args.seed, &mut |done, _| {
+        bar.set_position(done as u64);
+    })
+    .with_context(|| format!("writing frames to {}", args.out.display()))?;
+    bar.finish_and_clear();
+    let spinner = super::progress::spinner("ground truth", args.json);
     let references: Vec<_> = scenario.pairs.iter().map(|p| p.0).collect();
     let gold = gold_standard(
         &scenario.scene,
@@ -57,6 +62,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         scenario.max_range,
     )?;
     let truth = GroundTruth::from_scene(&scenario.scene, &gold);
+    spinner.finish_and_clear();
     gold.save(args.out.join("gold.fvx"))?;
     let mut occupied: Vec<_> = truth.occupied().collect();
     occupied.sort_unstable();

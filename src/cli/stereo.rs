@@ -111,12 +111,23 @@ pub fn run(args: StereoArgs) -> anyhow::Result<()> {
         Interval::Fixed => IntervalMethod::FixedDelta { delta: args.delta },
         Interval::Curve => IntervalMethod::CostCurve { delta: args.delta },
     };
+    let runs = args.repeat.max(1);
+    let bar = super::progress::bar(u64::from(runs), "matching", args.json);
     let mut result = depth_from_rectified(&left, &right, &geometry, 1.0, &params)?;
     let mut seconds = result.matching_seconds;
-    for _ in 1..args.repeat {
+    bar.inc(1);
+    for _ in 1..runs {
         result = depth_from_rectified(&left, &right, &geometry, 1.0, &params)?;
         seconds = seconds.min(result.matching_seconds);
+        bar.inc(1);
     }
+    bar.finish_and_clear();
+    tracing::info!(
+        "matched {}×{} in {:.1} ms (best of {runs})",
+        left.width(),
+        left.height(),
+        seconds * 1e3
+    );
     let disparity = &result.disparity;
     let image = result.frame.image();
     let accuracy: Option<Accuracy> = match &gt_path {

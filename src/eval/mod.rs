@@ -6,16 +6,18 @@
 //! holes (truly occupied voxels the map calls free); spurious occupied voxels in the truly
 //! unknown region (behind walls, in the sky); and the Chamfer distance from occupied voxel
 //! centres to the true surface.
-
+//!
 //! [`run_experiment`] feeds identical depth-stage output to every map, measures each after
 //! every phase and, optionally, plans flights in each map and checks them against the true
-//! scene ([`flights`](fly)).
+//! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
+//! ray-casting them into held-out frames.
 
 mod experiment;
 mod figures;
 mod flights;
 mod metrics;
 mod report;
+mod rgbd;
 mod truth;
 
 pub use experiment::{
@@ -28,4 +30,5 @@ pub use flights::{
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, write_experiment};
+pub use rgbd::{DepthAgreement, DepthCheckConfig, DepthErrors, HoldoutSplit};
 pub use truth::{GroundTruth, gold_standard, meets_geometry};

@@ -25,5 +25,5 @@ pub use evidence::{Evidence, EvidenceModel, IntegrationOptions, IntegrationStats
 pub use frustum::depth_evidence;
 pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;
-pub use raywalk::walk_ray;
+pub use raywalk::{walk_ray, walk_ray_until};
 pub use scan_sets::{BlockFlags, ScanSets, scan_sets};

@@ -1,3 +1,5 @@
+use std::ops::ControlFlow;
+
 use nalgebra::Point3;
 
 use crate::storage::{Resolution, VoxelKey};
@@ -18,6 +20,23 @@ pub fn walk_ray(
     end: VoxelKey,
     mut visit: impl FnMut(VoxelKey),
 ) {
+    let _: ControlFlow<()> = walk_ray_until(resolution, from, to, start, end, |key| {
+        visit(key);
+        ControlFlow::Continue(())
+    });
+}
+
+/// [`walk_ray`] that stops as soon as `visit` returns [`ControlFlow::Break`], and returns that
+/// break value (for ray casts that look for the first voxel of some kind).
+#[inline]
+pub fn walk_ray_until<B>(
+    resolution: &Resolution,
+    from: &Point3<f64>,
+    to: &Point3<f64>,
+    start: VoxelKey,
+    end: VoxelKey,
+    mut visit: impl FnMut(VoxelKey) -> ControlFlow<B>,
+) -> ControlFlow<B> {
     let direction = to - from;
     let size = resolution.size();
     // Per axis: the step (±1), the ray parameter t at the next voxel border, and the t it
@@ -39,7 +58,7 @@ pub fn walk_ray(
         + (i64::from(end.y) - i64::from(y)).unsigned_abs()
         + (i64::from(end.z) - i64::from(z)).unsigned_abs();
     while remaining > 0 {
-        visit(VoxelKey::new(x, y, z));
+        visit(VoxelKey::new(x, y, z))?;
         remaining -= 1;
         if t_x <= t_y && t_x <= t_z {
             x += step_x;
@@ -64,6 +83,7 @@ pub fn walk_ray(
             };
         }
     }
+    ControlFlow::Continue(())
 }
 
 #[cfg(test)]

@@ -9,9 +9,11 @@ mod mapfile;
 pub mod middlebury;
 pub mod octomap;
 pub mod pfm;
+pub mod ply;
 pub mod rgbd;
 pub mod rgbd_write;
 mod stored_blocks;
+pub mod views;
 
 pub use atomic::write_atomic;
 pub use cloud_text::read_text_cloud;

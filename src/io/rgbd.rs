@@ -2,13 +2,13 @@
 //! 0 = no reading), `frame-N.pose.txt` (4×4 `world_from_camera`, row-major) and
 //! `camera-intrinsics.txt` (3×3 K).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Matrix4};
 
 use crate::error::{Error, Result};
 use crate::geometry::{PinholeIntrinsics, pose_from_matrix};
-use crate::integrate::IntervalDepthImage;
+use crate::integrate::{DepthFrame, IntervalDepthImage};
 
 /// A depth image in metres, row-major; 0 where the sensor gave no reading.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,4 +121,100 @@ pub fn kinect_interval_image(depth: &DepthImage) -> Result<IntervalDepthImage> {
         let far = z + half;
         (near, far, (1.0 - 0.05 * (far - near)).max(0.0))
     })
+}
+
+/// The files of one frame of an RGB-D folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RgbdFrameFiles {
+    /// The frame number `N` of `frame-N.*`.
+    pub number: u64,
+    /// `frame-N.depth.png`.
+    pub depth: PathBuf,
+    /// `frame-N.pose.txt`.
+    pub pose: PathBuf,
+}
+
+/// An RGB-D folder in the 7-Scenes / 3DMatch layout: its frames in order of their number, and
+/// `camera-intrinsics.txt`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RgbdFolder {
+    /// The folder.
+    pub dir: PathBuf,
+    /// `camera-intrinsics.txt`.
+    pub intrinsics: PathBuf,
+    /// Every `frame-N.depth.png` with its `frame-N.pose.txt`, by increasing `N`.
+    pub frames: Vec<RgbdFrameFiles>,
+}
+
+impl RgbdFolder {
+    /// Lists the frames of `dir`. Every `frame-N.depth.png` needs its `frame-N.pose.txt` (a
+    /// missing one is an error, not a silently dropped frame), and the folder needs
+    /// `camera-intrinsics.txt` and at least one frame.
+    pub fn open(dir: &Path) -> Result<Self> {
+        let io = |source| Error::Io {
+            path: dir.to_path_buf(),
+            source,
+        };
+        let mut frames = Vec::new();
+        for entry in std::fs::read_dir(dir).map_err(io)? {
+            let name = entry.map_err(io)?.file_name();
+            let Some(name) = name.to_str() else { continue };
+            let Some(number) = name
+                .strip_prefix("frame-")
+                .and_then(|rest| rest.strip_suffix(".depth.png"))
+            else {
+                continue;
+            };
+            let parsed: u64 = number.parse().map_err(|_| Error::Parse {
+                path: dir.join(name),
+                line: 0,
+                message: format!("`{number}` is not a frame number"),
+            })?;
+            let pose = dir.join(format!("frame-{number}.pose.txt"));
+            if !pose.is_file() {
+                return Err(Error::Io {
+                    path: pose,
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::NotFound,
+                        format!("the pose of {name} is missing"),
+                    ),
+                });
+            }
+            frames.push(RgbdFrameFiles {
+                number: parsed,
+                depth: dir.join(name),
+                pose,
+            });
+        }
+        if frames.is_empty() {
+            return Err(Error::Empty("RGB-D folder (frame-N.depth.png files)"));
+        }
+        frames.sort_by_key(|f| f.number);
+        let intrinsics = dir.join("camera-intrinsics.txt");
+        if !intrinsics.is_file() {
+            return Err(Error::Io {
+                path: intrinsics,
+                source: std::io::Error::new(std::io::ErrorKind::NotFound, "no camera intrinsics"),
+            });
+        }
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            intrinsics,
+            frames,
+        })
+    }
+
+    /// Reads frame `index` (position in [`Self::frames`]) as Kinect depth with its noise
+    /// intervals ([`kinect_interval_image`]) and its pose.
+    pub fn read_kinect_frame(&self, index: usize) -> Result<DepthFrame> {
+        let files = self.frames.get(index).ok_or(Error::InvalidParameter {
+            name: "frame index",
+            value: index as f64,
+            expected: "an index below the folder's frame count",
+        })?;
+        let depth = read_depth_png_mm(&files.depth)?;
+        let intrinsics = read_intrinsics_txt(&self.intrinsics, depth.width, depth.height)?;
+        let pose = read_pose_txt(&files.pose)?;
+        DepthFrame::new(intrinsics, pose, kinect_interval_image(&depth)?)
+    }
 }

@@ -7,6 +7,7 @@ mod counts;
 mod function;
 mod fuzzy;
 mod logodds;
+mod raycast;
 
 pub use alpha::{AlphaConfig, AlphaCutMap};
 pub use any::AnyMap;
@@ -15,6 +16,7 @@ pub use counts::VoxelCounts;
 pub use function::FunctionMap;
 pub use fuzzy::FuzzyMap;
 pub use logodds::{LogOdds, LogOddsConfig, LogOddsMap};
+pub use raycast::{RayHit, cast_ray};
 
 use nalgebra::Point3;
 
