@@ -6,6 +6,7 @@ use anyhow::Context;
 use clap::Args;
 use fuzzyvox::eval::{file_stem, write_experiment};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
+use fuzzyvox::plan::UnknownPolicy;
 use fuzzyvox::sim::scenario;
 
 use super::eval::{experiment_config, run_with_bar};
@@ -48,7 +49,14 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             scenario.name,
             scenario.pairs.len()
         );
-        let config = experiment_config(&scenario, 0.2, Vec::new(), 1, flights);
+        let config = experiment_config(
+            &scenario,
+            0.2,
+            Vec::new(),
+            1,
+            flights,
+            UnknownPolicy::Forbid,
+        );
         let output = run_with_bar(&scenario, &config, false)?;
         let (section, _) = write_experiment(&args.out, &scenario, &output)?;
         report.push_str(&section);

@@ -7,7 +7,10 @@ use fuzzyvox::Family;
 use fuzzyvox::eval::{
     ExperimentConfig, FlightConfig, run_experiment_with_progress, write_experiment,
 };
+use fuzzyvox::plan::{PlannerConfig, UnknownPolicy};
 use fuzzyvox::sim::scenario::{self, Scenario};
+
+use super::plan::Unknown;
 
 /// Run one of the paper's scenarios: render every stereo pair, run the depth stage, feed the
 /// same depth to the log-odds, alpha-cut and fuzzy maps, and measure each against the truth;
@@ -37,6 +40,13 @@ pub struct EvalArgs {
     /// Plan this many random flights in every map and check them against the true scene.
     #[arg(long, default_value_t = 0)]
     plan: usize,
+    /// Unknown space for the planned flights: forbidden (only known-safe space is flown), or
+    /// allowed at a cost (optimistic exploration).
+    #[arg(long, value_enum, default_value_t = Unknown::Forbid)]
+    unknown: Unknown,
+    /// Extra cost per metre through unknown space (with `--unknown cost`).
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    unknown_cost: f32,
     /// Write metrics.json, report.md, every map (.fvx) and the figures (PNG) here.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -71,6 +81,7 @@ pub fn experiment_config(
     operators: Vec<Family>,
     seed: u64,
     plan: usize,
+    unknown: UnknownPolicy,
 ) -> ExperimentConfig {
     let mut sample_pairs: Vec<usize> = scenario.phases.iter().map(|(_, r)| r.start).collect();
     if scenario.phases.len() == 1 && scenario.pairs.len() > 2 {
@@ -85,7 +96,10 @@ pub fn experiment_config(
             seed,
             altitude: scenario.flight_altitude,
             distance: scenario.flight_distance,
-            ..FlightConfig::default()
+            planner: PlannerConfig {
+                unknown,
+                ..PlannerConfig::default()
+            },
         }),
         sample_pairs,
         ..ExperimentConfig::default()
@@ -121,7 +135,14 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         .map(|op| op.parse::<Family>().with_context(|| format!("--ops {op}")))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let scenario = args.scenario.build(args.pairs, args.seed)?;
-    let config = experiment_config(&scenario, args.res, operators, args.seed, args.plan);
+    let config = experiment_config(
+        &scenario,
+        args.res,
+        operators,
+        args.seed,
+        args.plan,
+        args.unknown.policy(args.unknown_cost),
+    );
     let started = Instant::now();
     let output = run_with_bar(&scenario, &config, args.json)?;
     let seconds = started.elapsed().as_secs_f64();
@@ -132,9 +153,9 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         fuzzyvox::io::write_atomic(&dir.join("metrics.json"), json.as_bytes())?;
         let (section, _) = write_experiment(dir, &scenario, &output)?;
         let page = format!(
-            "# fuzzyvox eval: {} scenario\n\nCommand: `fuzzyvox eval --scenario {} --pairs {} \
-             --seed {} --res {} --plan {}`; {seconds:.1} s.\n\n{section}",
-            scenario.name, scenario.name, report.pairs, args.seed, args.res, args.plan
+            "# fuzzyvox eval: {} scenario\n\nCommand: `fuzzyvox {}`; {seconds:.1} s.\n\n{section}",
+            scenario.name,
+            std::env::args().skip(1).collect::<Vec<_>>().join(" ")
         );
         fuzzyvox::io::write_atomic(&dir.join("report.md"), page.as_bytes())?;
     }

@@ -42,11 +42,21 @@ pub struct PlanArgs {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Unknown {
+pub enum Unknown {
     /// Never enter unknown space.
     Forbid,
     /// Enter unknown space at `--unknown-cost` per metre.
     Cost,
+}
+
+impl Unknown {
+    /// The planner's policy, with `cost` per metre through unknown space.
+    pub fn policy(self, cost: f32) -> UnknownPolicy {
+        match self {
+            Self::Forbid => UnknownPolicy::Forbid,
+            Self::Cost => UnknownPolicy::Cost(cost),
+        }
+    }
 }
 
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
@@ -62,10 +72,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let config = PlannerConfig {
         vehicle_radius: args.radius,
         safety_threshold: args.safety,
-        unknown: match args.unknown {
-            Unknown::Forbid => UnknownPolicy::Forbid,
-            Unknown::Cost => UnknownPolicy::Cost(args.unknown_cost),
-        },
+        unknown: args.unknown.policy(args.unknown_cost),
         ..PlannerConfig::default()
     };
     let started = Instant::now();

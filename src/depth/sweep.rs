@@ -17,9 +17,9 @@
 //! answer for motion along the view. There is no left-right check (the other image has no
 //! sweep of its own).
 //!
-//! Memory is bounded by the image: the image is cut into bands of rows that threads sweep
-//! independently (each band with a halo of half a window), in two streaming passes over the
-//! planes (best cost and its neighbours; then the runner-up and the cost-curve range).
+//! Memory is bounded by a band of rows times the planes: the image is cut into bands of rows
+//! that threads sweep independently (each band with a halo of half a window), keeping the
+//! band's aggregated costs on every plane (at most 32 rows × width × 1024 planes × 2 bytes).
 
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -143,35 +143,50 @@ impl Sweep {
         )
     }
 
-    /// Raw census costs of reference row `y` on plane `k`, written into `out` (one per column).
+    /// `M x̃` for every pixel of reference row `y`.
+    fn row_rays(&self, y: usize, width: usize, out: &mut Vec<[f32; 3]>) {
+        let [m0, m1, m2] = self.homography;
+        let yf = y as f32;
+        out.extend((0..width).map(|x| {
+            let xf = x as f32;
+            [
+                m0[0] * xf + m0[1] * yf + m0[2],
+                m1[0] * xf + m1[1] * yf + m1[2],
+                m2[0] * xf + m2[1] * yf + m2[2],
+            ]
+        }));
+    }
+
+    /// Raw census costs of reference row `y` (whose rays are `rays`) on plane `k`, written
+    /// into `out` (one per column).
     fn row_costs(
         &self,
         y: usize,
+        rays: &[[f32; 3]],
         k: u32,
         reference: &CensusImage,
         other: &CensusImage,
         out: &mut [u8],
     ) {
         let inverse = (self.inverse_far + self.step * f64::from(k)) as f32;
-        let [m0, m1, m2] = self.homography;
-        let b = self.translation;
-        let yf = y as f32;
+        let b = self.translation.map(|v| v * inverse);
         let (w, h) = (other.width as f32, other.height as f32);
         let row = y * reference.width;
-        for (x, cost) in out.iter_mut().enumerate() {
-            let xf = x as f32;
-            let qz = m2[0] * xf + m2[1] * yf + m2[2] + inverse * b[2];
-            let qx = m0[0] * xf + m0[1] * yf + m0[2] + inverse * b[0];
-            let qy = m1[0] * xf + m1[1] * yf + m1[2] + inverse * b[1];
+        let codes = &reference.codes[row..row + out.len()];
+        let valid = &reference.valid[row..row + out.len()];
+        for (((cost, a), &code), &ok) in out.iter_mut().zip(rays).zip(codes).zip(valid) {
             *cost = CENSUS_MAX_COST;
-            if qz <= 1e-6 || !reference.valid[row + x] {
+            let qz = a[2] + b[2];
+            if qz <= 1e-6 || !ok {
                 continue;
             }
-            let (u, v) = ((qx / qz + 0.5).floor(), (qy / qz + 0.5).floor());
+            let inv = 1.0 / qz;
+            // Nearest pixel: truncation equals floor for the non-negative values kept.
+            let (u, v) = ((a[0] + b[0]) * inv + 0.5, (a[1] + b[1]) * inv + 0.5);
             if u >= 0.0 && v >= 0.0 && u < w && v < h {
                 let j = v as usize * other.width + u as usize;
                 if other.valid[j] {
-                    *cost = (reference.codes[row + x] ^ other.codes[j]).count_ones() as u8;
+                    *cost = (code ^ other.codes[j]).count_ones() as u8;
                 }
             }
         }
@@ -237,16 +252,44 @@ fn aggregate(
             }
         }
     }
+    // Vertical running sums over the clipped windows, one output row at a time.
+    let mut column = vec![0u16; width];
+    let window = |y: usize| {
+        (
+            y.saturating_sub(ry).max(first) - first,
+            (y + ry).min(height - 1) - first,
+        )
+    };
+    let (mut top, mut bottom) = window(y0);
+    for r in top..=bottom {
+        for (c, &s) in column
+            .iter_mut()
+            .zip(&horizontal[r * width..(r + 1) * width])
+        {
+            *c += s;
+        }
+    }
     for (i, row) in out.chunks_exact_mut(width).enumerate() {
-        let y = y0 + i;
-        let top = y.saturating_sub(ry).max(first) - first;
-        let bottom = (y + ry).min(height - 1) - first;
-        row.fill(0);
-        for r in top..=bottom {
-            for (o, &s) in row.iter_mut().zip(&horizontal[r * width..(r + 1) * width]) {
-                *o += s;
+        let (t, b) = window(y0 + i);
+        while bottom < b {
+            bottom += 1;
+            for (c, &s) in column
+                .iter_mut()
+                .zip(&horizontal[bottom * width..(bottom + 1) * width])
+            {
+                *c += s;
             }
         }
+        while top < t {
+            for (c, &s) in column
+                .iter_mut()
+                .zip(&horizontal[top * width..(top + 1) * width])
+            {
+                *c -= s;
+            }
+            top += 1;
+        }
+        row.copy_from_slice(&column);
     }
 }
 
@@ -267,14 +310,20 @@ fn sweep_band(
     );
     let first = y0.saturating_sub(radius.1);
     let last = (y1 + radius.1).min(height);
+    let mut rays = Vec::with_capacity((last - first) * width);
+    for y in first..last {
+        sweep.row_rays(y, width, &mut rays);
+    }
     let mut raw = vec![0u8; (last - first) * width];
     let mut horizontal = vec![0u16; raw.len()];
-    let mut costs = vec![0u16; (y1 - y0) * width];
-    let mut previous = vec![u16::MAX; costs.len()];
-    let mut state = vec![PixelState::default(); costs.len()];
-    let mut plane_costs = |k: u32, costs: &mut [u16]| {
+    let n = (y1 - y0) * width;
+    // The band's aggregated costs on every plane, plane after plane.
+    let mut volume = vec![0u16; n * sweep.planes as usize];
+    for (k, costs) in volume.chunks_exact_mut(n).enumerate() {
         for (r, row) in raw.chunks_exact_mut(width).enumerate() {
-            sweep.row_costs(first + r, k, reference, other, row);
+            let y = first + r;
+            let rays = &rays[r * width..(r + 1) * width];
+            sweep.row_costs(y, rays, k as u32, reference, other, row);
         }
         aggregate(
             &raw,
@@ -286,18 +335,19 @@ fn sweep_band(
             &mut horizontal,
             costs,
         );
-    };
+    }
+    let mut previous = vec![u16::MAX; n];
+    let mut state = vec![PixelState::default(); n];
     // Pass 1: the best plane and the costs on either side of it.
-    for k in 0..sweep.planes {
-        plane_costs(k, &mut costs);
-        for ((s, &c), &p) in state.iter_mut().zip(&costs).zip(&previous) {
+    for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
+        for ((s, &c), &p) in state.iter_mut().zip(costs).zip(&previous) {
             if c < s.best {
                 (s.best, s.best_plane, s.left, s.right) = (c, k, p, u16::MAX);
             } else if k == s.best_plane + 1 && s.best != u16::MAX {
                 s.right = c;
             }
         }
-        previous.copy_from_slice(&costs);
+        previous.copy_from_slice(costs);
     }
     // Pass 2: the best cost more than one plane away, and the cost-curve range.
     let tolerance = 1.0 + f64::from(params.range_tolerance);
@@ -305,9 +355,8 @@ fn sweep_band(
         .iter()
         .map(|s| (f64::from(s.best) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
         .collect();
-    for k in 0..sweep.planes {
-        plane_costs(k, &mut costs);
-        for ((s, &c), &limit) in state.iter_mut().zip(&costs).zip(&limits) {
+    for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
+        for ((s, &c), &limit) in state.iter_mut().zip(costs).zip(&limits) {
             if k.abs_diff(s.best_plane) > 1 {
                 s.runner_up = s.runner_up.min(c);
             }

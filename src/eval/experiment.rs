@@ -15,7 +15,7 @@ use crate::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, de
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions};
 use crate::map::{
-    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
+    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, VoxelMap,
 };
 use crate::ops::{Family, TConorm};
 use crate::sim::scenario::Scenario;
@@ -246,7 +246,8 @@ pub fn run_experiment_with_progress(
     let (flight_queries_list, flights) = match &config.flights {
         Some(flight_config) => {
             let t = Instant::now();
-            let queries = flight_queries(&scenario.scene, &gold, flight_config)?;
+            let known: Vec<&dyn VoxelMap> = maps.iter().map(|(_, m)| m.as_map()).collect();
+            let queries = flight_queries(&scenario.scene, &gold, &known, flight_config)?;
             let mut flights = vec![(
                 "truth".to_string(),
                 fly(&gold, &scenario.scene, &queries, &flight_config.planner),

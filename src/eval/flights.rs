@@ -76,10 +76,13 @@ pub struct FlightSummary {
 
 /// Draws start/goal pairs among the voxels that are truly free: free in the gold-standard map,
 /// within the altitude band, and at least the vehicle radius plus a voxel diagonal from every
-/// surface. Deterministic for a seed; fewer pairs come back when too few candidates exist.
+/// surface; and, so that every planner can start and stop, free in each map of `known_in`
+/// (the maps being compared). Deterministic for a seed; fewer pairs come back when too few
+/// candidates exist.
 pub fn flight_queries(
     scene: &Scene,
     gold: &dyn VoxelMap,
+    known_in: &[&dyn VoxelMap],
     config: &FlightConfig,
 ) -> Result<Vec<FlightQuery>> {
     config.planner.validate()?;
@@ -100,6 +103,9 @@ pub fn flight_queries(
             z >= config.altitude.0
                 && z <= config.altitude.1
                 && gold.measure_config().classify(m) == VoxelClass::Free
+                && known_in
+                    .iter()
+                    .all(|map| map.class_at(key) == VoxelClass::Free)
         })
         .map(|(key, _)| key)
         .collect();
@@ -234,9 +240,9 @@ mod tests {
             altitude: (1.5, 4.0),
             ..FlightConfig::default()
         };
-        let a = flight_queries(&scene, &map, &config).unwrap();
+        let a = flight_queries(&scene, &map, &[&map], &config).unwrap();
         assert_eq!(a.len(), 10);
-        assert_eq!(a, flight_queries(&scene, &map, &config).unwrap());
+        assert_eq!(a, flight_queries(&scene, &map, &[&map], &config).unwrap());
         for q in &a {
             let d = (q.to - q.from).norm();
             assert!((1.0..=3.0).contains(&d));
@@ -246,7 +252,14 @@ mod tests {
             }
         }
         let other = FlightConfig { seed: 2, ..config };
-        assert_ne!(a, flight_queries(&scene, &map, &other).unwrap());
+        assert_ne!(a, flight_queries(&scene, &map, &[], &other).unwrap());
+        // A map that knows nothing leaves no candidates.
+        let empty = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap();
+        assert!(
+            flight_queries(&scene, &map, &[&empty], &config)
+                .unwrap()
+                .is_empty()
+        );
     }
 
     #[test]

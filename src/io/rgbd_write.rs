@@ -129,7 +129,10 @@ mod tests {
         assert_eq!((back.width, back.height), (3, 2));
         let expected = [1.234, 0.0, 0.0, 0.0, 0.0, 12.5];
         assert!(
-            back.depth.iter().zip(expected).all(|(a, b)| (a - b).abs() < 1e-6),
+            back.depth
+                .iter()
+                .zip(expected)
+                .all(|(a, b)| (a - b).abs() < 1e-6),
             "{:?}",
             back.depth
         );
