@@ -163,3 +163,39 @@ fn demo_refuses_an_output_path_that_is_a_file() {
     );
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+#[test]
+fn demo_writes_the_report_maps_and_figures() {
+    let out = scratch("demo-run");
+    let run = fuzzyvox(&["demo", "--out", out.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for heading in ["## wall scenario", "## random scenario", "Planned flights"] {
+        assert!(report.contains(heading), "report lacks {heading}");
+    }
+    let metrics: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
+    for scenario in ["wall", "random"] {
+        for map in ["logodds", "alpha", "fuzzy"] {
+            let m = &metrics[scenario]["maps"][map];
+            assert!(m["occupied_f1"].is_number(), "{scenario}/{map}");
+            assert!(m["plan_queries"].as_u64().unwrap() > 0, "{scenario}/{map}");
+            for ext in ["fvx", "bt", "ply", "png"] {
+                let file = out.join(format!("{scenario}-{map}.{ext}"));
+                assert!(file.is_file(), "missing {}", file.display());
+            }
+        }
+    }
+    // Every figure the report links exists.
+    for link in report.split("](").skip(1) {
+        let name = &link[..link.find(')').unwrap()];
+        if name.ends_with(".png") {
+            assert!(out.join(name).is_file(), "report links a missing {name}");
+        }
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}

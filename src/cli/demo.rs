@@ -4,8 +4,10 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
+use fuzzyvox::VoxelClass;
 use fuzzyvox::eval::{file_stem, write_experiment};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
+use fuzzyvox::io::ply::{PlyEncoding, write_ply};
 use fuzzyvox::plan::UnknownPolicy;
 use fuzzyvox::sim::scenario;
 
@@ -63,6 +65,13 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         for (name, map) in &output.maps {
             let stem = format!("{}-{}", scenario.name, file_stem(name));
             write_bt_max_likelihood(&args.out.join(format!("{stem}.bt")), map.as_map())?;
+            // Occupied and ambiguous voxels with their measures, for any point-cloud viewer.
+            write_ply(
+                map.as_map(),
+                &[VoxelClass::Occupied, VoxelClass::Ambiguous],
+                PlyEncoding::BinaryLittleEndian,
+                &args.out.join(format!("{stem}.ply")),
+            )?;
         }
         all.insert(
             scenario.name.to_string(),
@@ -72,7 +81,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let _ = writeln!(
         report,
         "Each map is also saved as `.fvx` (open with `fuzzyvox info`, plan with `fuzzyvox \
-         plan`) and `.bt` (OctoMap's tools and octovis).\n\nTotal time {:.1} s.",
+         plan`), `.bt` (OctoMap's tools and octovis) and `.ply` (occupied and ambiguous voxel \
+         centres with their measures, for point-cloud viewers).\n\nTotal time {:.1} s.",
         started.elapsed().as_secs_f64()
     );
     fuzzyvox::io::write_atomic(&args.out.join("report.md"), report.as_bytes())?;
