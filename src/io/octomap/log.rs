@@ -28,6 +28,20 @@ use crate::geometry::validate_pose;
 ///
 /// Unlike OctoMap, which silently skips lines that start with a space, indented lines are read.
 pub fn read_scan_log(path: &Path) -> Result<Vec<ScanNode>> {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_log(BufReader::new(file), path)
+}
+
+/// Parses the bytes of an OctoMap scan log held in memory; see [`read_scan_log`]. Errors name
+/// the path `<memory>`.
+pub fn parse_scan_log(bytes: &[u8]) -> Result<Vec<ScanNode>> {
+    parse_log(bytes, Path::new("<memory>"))
+}
+
+fn parse_log(mut reader: impl BufRead, path: &Path) -> Result<Vec<ScanNode>> {
     let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
@@ -37,7 +51,6 @@ pub fn read_scan_log(path: &Path) -> Result<Vec<ScanNode>> {
         line,
         message,
     };
-    let mut reader = BufReader::new(std::fs::File::open(path).map_err(io)?);
     let mut nodes: Vec<ScanNode> = Vec::new();
     let mut bytes = Vec::new();
     let mut line_number = 0;
