@@ -386,7 +386,7 @@ const CALIB: &str = "cam0=[40 0 15.5; 0 40 11.5; 0 0 1]\ncam1=[40 0 15.5; 0 40 1
 
 fn png(width: u32, height: u32, shift: u32) -> Vec<u8> {
     let image = image::GrayImage::from_fn(width, height, |x, y| {
-        image::Luma([((x + shift) * 53 % 251 ^ (y * 29 % 251)) as u8])
+        image::Luma([(((x + shift) * 53 % 251) ^ (y * 29 % 251)) as u8])
     });
     let mut out = std::io::Cursor::new(Vec::new());
     image.write_to(&mut out, image::ImageFormat::Png).unwrap();
