@@ -153,11 +153,21 @@ fn map_body_of_garbage_behind_a_valid_checksum_is_invalid() {
         format_reason(FuzzyMap::from_bytes(&bytes)),
         FormatError::Invalid(_)
     ));
-    // A body that declares a billion blocks in a few bytes: postcard must not preallocate.
+    // An empty map's body ends with its block count, 0. Declaring four billion blocks there
+    // (with no bytes behind them) is refused without reserving memory for them.
+    let mut bytes = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap())
+        .unwrap()
+        .to_bytes();
+    assert_eq!(bytes.pop(), Some(0), "the block count ends an empty map");
+    bytes.extend_from_slice(&[0xff, 0xff, 0xff, 0xff, 0x0f]);
+    repair(&mut bytes);
+    assert!(matches!(
+        format_reason(FuzzyMap::from_bytes(&bytes)),
+        FormatError::Invalid(_)
+    ));
+    // A body with nothing after the header.
     let mut bytes = fuzzy_map().to_bytes();
     bytes.truncate(40);
-    // Config (resolution, operator, measures...) is not there at all: still a typed error.
-    bytes.extend_from_slice(&[0xff, 0xff, 0xff, 0xff, 0x0f]);
     repair(&mut bytes);
     assert!(matches!(
         format_reason(FuzzyMap::from_bytes(&bytes)),
@@ -831,4 +841,107 @@ fn intrinsics_with_skew_or_bad_focal_lengths_are_errors() {
         parse_intrinsics_txt(b"585 0 320\n0 585 240\n", 640, 480),
         Err(Error::Parse { .. })
     ));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Every text format, cut or flipped anywhere
+// ---------------------------------------------------------------------------------------------
+
+/// Whether an error is one a text reader may give for damaged text.
+fn text_error(error: &Error) -> bool {
+    matches!(
+        error,
+        Error::Parse { .. }
+            | Error::Empty(_)
+            | Error::InvalidPose(_)
+            | Error::InvalidParameter { .. }
+            | Error::NonFinite { .. }
+            | Error::InvalidConfidence { .. }
+    )
+}
+
+#[test]
+fn text_files_cut_or_flipped_anywhere_are_errors_or_still_valid() {
+    // Text formats have no checksum: a cut at a line end, or a flipped digit, can leave a valid
+    // file. Whatever the damage, the reader returns a value or one of the typed text errors.
+    let log = "# log\nNODE 1 2 3 0.1 -0.2 0.3\n1 0 0\n  nan 0 1\nNODE 0 0 0 0 0 0\n2 2 2\n";
+    let cloud = "# x y z c\n1 2 3 0.5\n4,5,6,1\n\n-1.5e2 0 2 0.25\n";
+    let k = "585 0 320\n0 585 240\n0 0 1\n";
+    type Reader = fn(&[u8]) -> Result<(), Error>;
+    let readers: [(&str, &str, Reader); 5] = [
+        ("log", log, |b| parse_scan_log(b).map(|_| ())),
+        ("cloud", cloud, |b| {
+            parse_text_cloud(b, Point3::origin()).map(|_| ())
+        }),
+        ("calib", CALIB, |b| parse_calib(b).map(|_| ())),
+        ("pose", POSE, |b| parse_pose_txt(b).map(|_| ())),
+        ("intrinsics", k, |b| {
+            parse_intrinsics_txt(b, 640, 480).map(|_| ())
+        }),
+    ];
+    for (name, text, read) in readers {
+        let bytes = text.as_bytes();
+        assert!(read(bytes).is_ok(), "{name}: the undamaged file reads");
+        let mut errors = 0;
+        for len in 0..bytes.len() {
+            if let Err(error) = read(&bytes[..len]) {
+                assert!(text_error(&error), "{name} cut to {len}: {error:?}");
+                errors += 1;
+            }
+        }
+        for at in 0..bytes.len() {
+            for bit in [0x01, 0x08, 0x20, 0x80] {
+                let mut flipped = bytes.to_vec();
+                flipped[at] ^= bit;
+                if let Err(error) = read(&flipped) {
+                    assert!(
+                        text_error(&error),
+                        "{name}: flip {bit:#x} at {at}: {error:?}"
+                    );
+                    errors += 1;
+                }
+            }
+        }
+        assert!(errors > bytes.len(), "{name}: damage went unnoticed");
+    }
+}
+
+#[test]
+fn graph_and_pfm_bit_flips_give_an_error_or_a_consistent_result() {
+    // Neither format has a checksum: a flipped bit in a coordinate or a sample is another valid
+    // file. A flipped count, tag or header is an error; nothing panics or allocates wildly.
+    let graph_bytes = graph(3, [0.5, -1.0, 2.0]);
+    let mut refused = 0;
+    for at in 0..graph_bytes.len() {
+        for bit in [0x01, 0x10, 0x80] {
+            let mut flipped = graph_bytes.clone();
+            flipped[at] ^= bit;
+            match decode_scan_graph(&flipped) {
+                Ok(nodes) => {
+                    for node in nodes {
+                        assert!(node.to_cloud().is_ok(), "flip {bit:#x} at {at}");
+                    }
+                }
+                Err(_) => refused += 1,
+            }
+        }
+    }
+    assert!(refused > 0);
+    let pfm = encode_pfm(3, 2, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();
+    let header_len = pfm.len() - 24;
+    for at in 0..pfm.len() {
+        for bit in [0x01, 0x10, 0x80] {
+            let mut flipped = pfm.clone();
+            flipped[at] ^= bit;
+            match parse_pfm(&flipped) {
+                Ok(image) => {
+                    assert_eq!(
+                        image.data.len(),
+                        image.width as usize * image.height as usize
+                    );
+                }
+                Err(_) => assert!(at < header_len, "a flipped sample at {at} was refused"),
+            }
+        }
+    }
 }
