@@ -7,10 +7,10 @@ use libfuzzer_sys::fuzz_target;
 use nalgebra::Point3;
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(cloud) = parse_text_cloud(data, Point3::origin()) {
-        if let Some(confidence) = cloud.confidence() {
-            assert_eq!(confidence.len(), cloud.len());
-            assert!(confidence.iter().all(|c| (0.0..=1.0).contains(c)));
-        }
+    if let Ok(cloud) = parse_text_cloud(data, Point3::origin())
+        && let Some(confidence) = cloud.confidence()
+    {
+        assert_eq!(confidence.len(), cloud.len());
+        assert!(confidence.iter().all(|c| (0.0..=1.0).contains(c)));
     }
 });
