@@ -349,6 +349,28 @@ fn a_camera_outside_the_key_range_is_an_error_in_every_map() {
     }
 }
 
+#[test]
+fn a_skewed_camera_whose_frustum_box_is_huge_integrates_quickly() {
+    // Found by fuzzing: one pixel, a principal point 8,000 px off the image and fy = 5e46 make a
+    // sliver of a frustum 780 m long whose bounding box holds 19 million blocks, all near the
+    // camera plane. Culling used to test every block (7 s for one pixel); whole groups of blocks
+    // beside the frustum's side planes are now skipped.
+    let k = PinholeIntrinsics::new(1, 1, 31.875, 5.03e46, 8191.875, 8164.875).unwrap();
+    let image =
+        IntervalDepthImage::new(1, 1, vec![2.98], vec![3.0], vec![3.03], vec![0.78]).unwrap();
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.06, -241.59, -20.49),
+        UnitQuaternion::from_euler_angles(-1e-3, -1e-3, 10.239),
+    );
+    let frame = DepthFrame::new(k, pose, image).unwrap();
+    let mut map = FuzzyMap::new(FuzzyConfig::new(0.05).unwrap()).unwrap();
+    let started = std::time::Instant::now();
+    let stats = map.integrate_depth(&frame, &Default::default()).unwrap();
+    let seconds = started.elapsed().as_secs_f64();
+    assert_eq!(stats.integrated, 1);
+    assert!(seconds < 5.0, "one pixel took {seconds:.1} s");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Depth stage
 // ---------------------------------------------------------------------------------------------
