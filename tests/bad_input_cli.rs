@@ -282,6 +282,15 @@ fn info_refuses_damaged_empty_and_foreign_files() {
     let bt = dir.join("map.bt");
     let out = fuzzyvox(&["export", &map, "--bt", bt.to_str().unwrap()]);
     assert!(out.status.success());
+    if Path::new("/dev/zero").exists() {
+        // An endless device: the header's 40 bytes are enough to refuse it.
+        fails(&["info", "/dev/zero"], 1, "not a fuzzyvox map");
+        fails(
+            &["insert", "--cloud", "/dev/zero", "--res", "0.1"],
+            1,
+            "line longer",
+        );
+    }
     for (path, expected) in [
         (truncated.as_str(), "length mismatch"),
         (flipped.as_str(), "checksum"),

@@ -945,3 +945,72 @@ fn graph_and_pfm_bit_flips_give_an_error_or_a_consistent_result() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Inputs that never end, and files far larger than their header says
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn endless_inputs_are_errors_not_endless_reads() {
+    let zero = Path::new("/dev/zero");
+    if !zero.exists() {
+        eprintln!("SKIPPED endless_inputs_are_errors_not_endless_reads: no /dev/zero here");
+        return;
+    }
+    // Each of these would read forever (and exhaust memory) if it trusted the input to end.
+    assert_eq!(format_reason(AnyMap::load(zero)), FormatError::BadMagic);
+    assert_eq!(format_reason(read_header(zero)), FormatError::BadMagic);
+    assert_eq!(parse_line(read_text_cloud(zero, Point3::origin())), 1);
+    assert_eq!(parse_line(read_scan_log(zero)), 1);
+    assert!(matches!(
+        read_calib(zero),
+        Err(Error::Parse { line: 0, .. })
+    ));
+    assert!(matches!(
+        read_pose_txt(zero),
+        Err(Error::Parse { line: 0, .. })
+    ));
+    for result in [
+        read_bt(zero).map(|_| ()),
+        read_scan_graph(zero).map(|_| ()),
+        fuzzyvox::io::pfm::read_pfm(zero).map(|_| ()),
+    ] {
+        assert!(matches!(result, Err(Error::Io { .. })), "{result:?}");
+    }
+    assert!(matches!(read_depth_png_mm(zero), Err(Error::Parse { .. })));
+}
+
+#[test]
+fn a_map_file_larger_than_its_header_says_is_refused_before_reading_it() {
+    // A valid header declaring this map's body, then a gigabyte (a sparse file: no disk used).
+    let dir = scratch("huge-map");
+    let path = dir.join("map.fvx");
+    let bytes = fuzzy_map().to_bytes();
+    std::fs::write(&path, &bytes).unwrap();
+    let file = std::fs::OpenOptions::new().write(true).open(&path).unwrap();
+    file.set_len(1 << 30).unwrap();
+    drop(file);
+    let declared = (bytes.len() - 40) as u64;
+    let started = std::time::Instant::now();
+    let reason = format_reason(FuzzyMap::load(&path));
+    assert_eq!(
+        reason,
+        FormatError::Length {
+            declared,
+            actual: (1 << 30) - 40
+        }
+    );
+    assert_eq!(format_reason(read_header(&path)), reason);
+    let seconds = started.elapsed().as_secs_f64();
+    assert!(seconds < 1.0, "took {seconds:.2} s: the body was read");
+    // A text line of more than a megabyte is refused at the limit.
+    let long = write(&dir, "long.xyz", vec![b'1'; (1 << 20) + 10]);
+    let message = match read_text_cloud(&long, Point3::origin()) {
+        Err(Error::Parse {
+            line: 1, message, ..
+        }) => message,
+        other => panic!("{other:?}"),
+    };
+    assert!(message.contains("line longer"), "{message}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -3,6 +3,7 @@ use std::path::Path;
 
 use nalgebra::Point3;
 
+use super::bounded::read_line;
 use crate::error::{Error, Result};
 use crate::integrate::PointCloud;
 
@@ -39,16 +40,9 @@ fn parse_cloud(mut reader: impl BufRead, path: &Path, origin: Point3<f64>) -> Re
     let mut bytes = Vec::new();
     let mut line_number = 0;
     loop {
-        bytes.clear();
         // Bytes, not `read_line`: a binary file is a parse error naming the line, not an I/O
         // error.
-        let read = reader
-            .read_until(b'\n', &mut bytes)
-            .map_err(|source| Error::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        if read == 0 {
+        if read_line(&mut reader, &mut bytes, path, line_number + 1)? == 0 {
             break;
         }
         line_number += 1;

@@ -14,6 +14,7 @@
 //! | 36..40 | CRC32 of bytes 0..36 followed by the body |
 //! | 40.. | body (postcard) |
 
+use std::io::Read;
 use std::path::Path;
 
 use serde::Serialize;
@@ -82,10 +83,7 @@ pub struct MapHeader {
 
 /// Reads and checks a map file's header and checksum without decoding the body.
 pub fn read_header(path: &Path) -> Result<MapHeader> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_file(path)?;
     split(&bytes)
         .map(|(header, _)| header)
         .map_err(|reason| Error::Format {
@@ -212,14 +210,51 @@ pub(crate) fn load_with<T>(
     path: &Path,
     decode: impl FnOnce(&[u8]) -> Result<T, FormatError>,
 ) -> Result<T> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_file(path)?;
     decode(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
         reason,
     })
+}
+
+/// Reads a map file header first: a file without the magic, or whose size is not the header's
+/// declared length, is refused before its body is read (so a wrong path to a huge file, or a
+/// device such as `/dev/zero`, costs 40 bytes). At most the declared length is read even from a
+/// stream, and memory grows only with the bytes that actually arrive.
+fn read_file(path: &Path) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::with_capacity(HEADER_LEN);
+    (&mut file)
+        .take(HEADER_LEN as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    let Ok(header) = <&[u8; HEADER_LEN]>::try_from(bytes.as_slice()) else {
+        // Too short: `split` names the problem.
+        return Ok(bytes);
+    };
+    if !header.starts_with(MAGIC) {
+        return Ok(bytes);
+    }
+    let declared = u64::from_le_bytes(field(header, 28));
+    let metadata = file.metadata().map_err(io)?;
+    if metadata.is_file() {
+        let actual = metadata.len().saturating_sub(HEADER_LEN as u64);
+        if actual != declared {
+            return Err(Error::Format {
+                path: path.to_path_buf(),
+                reason: FormatError::Length { declared, actual },
+            });
+        }
+    }
+    // One byte more than declared, so that a longer stream is a length error, not a long read.
+    file.take(declared.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    Ok(bytes)
 }
 
 /// Decodes map bytes held in memory.

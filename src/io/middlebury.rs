@@ -41,10 +41,7 @@ impl MiddleburyCalib {
 
 /// Reads a Middlebury `calib.txt`.
 pub fn read_calib(path: &Path) -> Result<MiddleburyCalib> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = super::bounded::read_small(path)?;
     calib_from(&bytes, path)
 }
 

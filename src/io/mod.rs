@@ -6,6 +6,7 @@
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 
 mod atomic;
+mod bounded;
 mod cloud_text;
 mod fuzzy_file;
 mod logodds_file;

@@ -25,10 +25,7 @@ pub struct FloatImage {
 
 /// Reads a one-channel PFM file.
 pub fn read_pfm(path: &Path) -> Result<FloatImage> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::io::bounded::read_regular(path)?;
     parse_pfm(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
         reason,

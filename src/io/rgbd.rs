@@ -75,10 +75,7 @@ fn depth_png_from<R: std::io::BufRead + std::io::Seek>(
 
 /// Reads a whitespace-separated text matrix of `rows × cols` numbers.
 fn read_matrix(path: &Path, rows: usize, cols: usize) -> Result<Vec<f64>> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = super::bounded::read_small(path)?;
     matrix_from(&bytes, path, rows, cols)
 }
 

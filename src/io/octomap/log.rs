@@ -16,6 +16,7 @@ use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
 use super::scan::ScanNode;
 use crate::error::{Error, Result};
 use crate::geometry::validate_pose;
+use crate::io::bounded::read_line;
 
 /// Reads an OctoMap scan log: a `NODE x y z roll pitch yaw` line starts each scan and is followed
 /// by its points, one `x y z` per line in the sensor frame. Fields are separated by whitespace;
@@ -42,10 +43,6 @@ pub fn parse_scan_log(bytes: &[u8]) -> Result<Vec<ScanNode>> {
 }
 
 fn parse_log(mut reader: impl BufRead, path: &Path) -> Result<Vec<ScanNode>> {
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
     let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
         line,
@@ -55,10 +52,9 @@ fn parse_log(mut reader: impl BufRead, path: &Path) -> Result<Vec<ScanNode>> {
     let mut bytes = Vec::new();
     let mut line_number = 0;
     loop {
-        bytes.clear();
         // Bytes, not `read_line`: a binary file must be a parse error naming the line, not an
         // I/O error.
-        if reader.read_until(b'\n', &mut bytes).map_err(io)? == 0 {
+        if read_line(&mut reader, &mut bytes, path, line_number + 1)? == 0 {
             break;
         }
         line_number += 1;
