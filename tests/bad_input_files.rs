@@ -818,11 +818,16 @@ fn pose_with_the_wrong_count_of_numbers_is_a_parse_error() {
 fn intrinsics_with_skew_or_bad_focal_lengths_are_errors() {
     let k = "585 0 320\n0 585 240\n0 0 1\n";
     assert!(parse_intrinsics_txt(k.as_bytes(), 640, 480).is_ok());
-    let skew = k.replacen("585 0 320", "585 3 320", 1);
-    assert!(matches!(
-        parse_intrinsics_txt(skew.as_bytes(), 640, 480),
-        Err(Error::Parse { .. })
-    ));
+    for skew in ["585 3 320", "585 nan 320"] {
+        let text = k.replacen("585 0 320", skew, 1);
+        assert!(
+            matches!(
+                parse_intrinsics_txt(text.as_bytes(), 640, 480),
+                Err(Error::Parse { .. })
+            ),
+            "{skew}"
+        );
+    }
     let zero = k.replacen("585 0 320", "0 0 320", 1);
     assert!(matches!(
         parse_intrinsics_txt(zero.as_bytes(), 640, 480),

@@ -151,7 +151,11 @@ fn intrinsics_from(k: &[f64], path: &Path, width: u32, height: u32) -> Result<Pi
             message: format!("expected 3×3 numbers, found {}", k.len()),
         });
     };
-    if skew.abs() > 1e-9 || zero_10.abs() > 1e-9 || zero_20.abs() > 1e-9 || zero_21.abs() > 1e-9 {
+    // Written so that NaN fails too.
+    if ![skew, zero_10, zero_20, zero_21]
+        .iter()
+        .all(|v| v.abs() <= 1e-9)
+    {
         return Err(Error::Parse {
             path: path.to_path_buf(),
             line: 0,
