@@ -138,6 +138,12 @@ pub struct IntegrationOptions {
 }
 
 impl IntegrationOptions {
+    /// The longest ray, in voxels, that a point-cloud integration walks: 65,536 voxels (6.5 km
+    /// at 10 cm, 655 m at 1 cm), beyond any real sensor's range. A longer ray (a glitch at
+    /// 10⁶ m, say) would allocate free space along all of its length, so it is an error
+    /// ([`Error::InvalidParameter`]) before anything changes; set `max_range` to cut such rays.
+    pub const MAX_RAY_VOXELS: f64 = 65_536.0;
+
     /// Checks that `max_range`, when set, is finite and positive.
     pub fn validate(self) -> Result<Self> {
         if let Some(range) = self.max_range {
@@ -165,4 +171,17 @@ pub struct IntegrationStats {
     pub clipped: usize,
     /// Voxels whose cells received evidence.
     pub voxels_updated: usize,
+}
+
+/// Refuses a ray longer than [`IntegrationOptions::MAX_RAY_VOXELS`] voxels of `resolution`
+/// metres (`range` already cut at `max_range`).
+pub(crate) fn check_ray_length(range: f64, resolution: f64) -> Result<()> {
+    if range / resolution > IntegrationOptions::MAX_RAY_VOXELS {
+        return Err(Error::InvalidParameter {
+            name: "ray length",
+            value: range,
+            expected: "a ray of at most 65,536 voxels; set max_range to cut longer rays",
+        });
+    }
+    Ok(())
 }

@@ -16,6 +16,9 @@ const MAX_FRUSTUM_BLOCKS: u128 = 1 << 26;
 /// Side of the square pixel tiles whose largest far depth culls blocks.
 const TILE: u32 = 8;
 
+/// Blocks per side of the groups culled before their blocks.
+const GROUP: i32 = 8;
+
 /// Turns an interval depth image into one scan's evidence by projective frustum integration.
 ///
 /// Every block that the camera frustum touches in front of the observed surfaces is visited;
@@ -83,10 +86,7 @@ pub fn depth_evidence(
             expected: "a frustum of at most 2^26 blocks at this resolution; set max_range",
         });
     }
-    let candidates: Vec<BlockKey> = frustum
-        .blocks()
-        .filter(|&key| camera.block_may_be_observed(key, &tiles))
-        .collect();
+    let candidates = camera.observed_blocks(&frustum, &tiles);
 
     let blocks: Vec<(BlockKey, Box<Block<Evidence>>)> = candidates
         .par_iter()
@@ -289,6 +289,9 @@ impl TileReach {
 struct CameraView {
     camera_from_world: Matrix3<f64>,
     camera_in_world: Vector3<f64>,
+    /// Inward unit normals of the four planes through the camera centre that bound the image
+    /// (`u >= -0.5`, `u <= w - 0.5`, `v >= -0.5`, `v <= h - 0.5`), in the camera frame.
+    sides: [Vector3<f64>; 4],
     fx: f64,
     fy: f64,
     cx: f64,
@@ -302,9 +305,18 @@ impl CameraView {
     fn new(frame: &DepthFrame, resolution: &Resolution) -> Self {
         let pose = frame.world_from_camera();
         let k = frame.intrinsics();
+        let (w, h) = (f64::from(k.width()), f64::from(k.height()));
+        let sides = [
+            Vector3::new(k.fx(), 0.0, k.cx() + 0.5),
+            Vector3::new(-k.fx(), 0.0, w - 0.5 - k.cx()),
+            Vector3::new(0.0, k.fy(), k.cy() + 0.5),
+            Vector3::new(0.0, -k.fy(), h - 0.5 - k.cy()),
+        ]
+        .map(|n| n.normalize());
         Self {
             camera_from_world: pose.rotation.to_rotation_matrix().matrix().transpose(),
             camera_in_world: pose.translation.vector,
+            sides,
             fx: k.fx(),
             fy: k.fy(),
             cx: k.cx(),
@@ -319,13 +331,61 @@ impl CameraView {
         self.camera_from_world * (p.coords - self.camera_in_world)
     }
 
+    /// The blocks of `frustum` that may be observed, in the box's order (z slowest), culled
+    /// first by groups of [`GROUP`]³ blocks: a frustum whose bounding box is mostly empty (a
+    /// wide, skewed or far-reaching camera) costs one test per group, not one per block. The
+    /// test is conservative for any cube, so a culled group holds no observable block and the
+    /// result is the same as testing every block.
+    fn observed_blocks(&self, frustum: &KeyBox, tiles: &TileReach) -> Vec<BlockKey> {
+        let (lo, hi) = frustum.block_bounds();
+        let group_side = f64::from(GROUP) * BLOCK_SIDE as f64 * self.resolution.size();
+        let groups = |lo: i32, hi: i32| lo.div_euclid(GROUP)..=hi.div_euclid(GROUP);
+        let within =
+            |g: i32, lo: i32, hi: i32| (g * GROUP).max(lo)..=(g * GROUP + GROUP - 1).min(hi);
+        let mut blocks = Vec::new();
+        for gz in groups(lo.z, hi.z) {
+            for gy in groups(lo.y, hi.y) {
+                for gx in groups(lo.x, hi.x) {
+                    let first = BlockKey::new(gx * GROUP, gy * GROUP, gz * GROUP);
+                    let corner = self.resolution.corner(first.origin());
+                    if !self.cube_may_be_observed(corner, group_side, tiles) {
+                        continue;
+                    }
+                    for z in within(gz, lo.z, hi.z) {
+                        for y in within(gy, lo.y, hi.y) {
+                            for x in within(gx, lo.x, hi.x) {
+                                let key = BlockKey::new(x, y, z);
+                                if self.block_may_be_observed(key, tiles) {
+                                    blocks.push(key);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        blocks.sort_unstable_by_key(|k| (k.z, k.y, k.x));
+        blocks
+    }
+
     /// Whether any voxel of the block could lie in front of some pixel's reach (conservative).
     fn block_may_be_observed(&self, key: BlockKey, tiles: &TileReach) -> bool {
         let side = BLOCK_SIDE as f64 * self.resolution.size();
-        let corner = self.resolution.corner(key.origin());
+        self.cube_may_be_observed(self.resolution.corner(key.origin()), side, tiles)
+    }
+
+    /// Whether any point of the cube with lowest corner `corner` (world) and edge `side` could
+    /// lie in front of some pixel's reach (conservative: tests the cube's bounding sphere).
+    fn cube_may_be_observed(&self, corner: Point3<f64>, side: f64, tiles: &TileReach) -> bool {
         let center = self.to_camera(&(corner + Vector3::repeat(0.5 * side)));
         let radius = 0.5 * 3f64.sqrt() * side;
         if center.z + radius <= 0.0 {
+            return false;
+        }
+        // Wholly outside one of the planes that bound the image: no pixel sees it. This also
+        // culls cubes that straddle the camera plane beside the frustum.
+        let margin = radius * (1.0 + 1e-9) + 1e-9;
+        if self.sides.iter().any(|n| n.dot(&center) < -margin) {
             return false;
         }
         let near = center.z - radius;
@@ -420,4 +480,84 @@ fn frustum_box(frame: &DepthFrame, resolution: &Resolution, reach: f32) -> Resul
         hi = hi.sup(&corner.coords);
     }
     KeyBox::from_points(resolution, &Point3::from(lo), &Point3::from(hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::PinholeIntrinsics;
+    use crate::integrate::IntervalDepthImage;
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+    /// Every block of the frustum's box that the culling drops receives no evidence: culling
+    /// by groups and by the image's side planes only ever saves work.
+    #[test]
+    fn culling_drops_no_block_with_evidence() {
+        let frames = [
+            // An ordinary camera, tilted.
+            (
+                PinholeIntrinsics::new(24, 16, 20.0, 20.0, 11.5, 7.5).unwrap(),
+                Isometry3::from_parts(
+                    Translation3::new(0.3, -0.2, 1.0),
+                    UnitQuaternion::from_euler_angles(0.3, -0.7, 2.0),
+                ),
+            ),
+            // A principal point far off the image and unequal focal lengths.
+            (
+                PinholeIntrinsics::new(13, 9, 6.0, 25.0, 30.0, -4.0).unwrap(),
+                Isometry3::from_parts(
+                    Translation3::new(-1.0, 2.0, 0.5),
+                    UnitQuaternion::from_euler_angles(-1.2, 0.4, 0.1),
+                ),
+            ),
+            // A wide camera looking straight up.
+            (
+                PinholeIntrinsics::new(16, 16, 3.0, 3.0, 7.5, 7.5).unwrap(),
+                Isometry3::from_parts(
+                    Translation3::new(0.0, 0.0, -0.4),
+                    UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0),
+                ),
+            ),
+        ];
+        let resolution = Resolution::new(0.1).unwrap();
+        let model = EvidenceModel::default();
+        let operator = TConorm::default();
+        let half_diagonal = (0.5 * 3f64.sqrt() * resolution.size()) as f32;
+        for (index, (k, pose)) in frames.into_iter().enumerate() {
+            let n = (k.width() * k.height()) as usize;
+            let depth: Vec<f32> = (0..n).map(|i| 0.4 + (i % 11) as f32 * 0.35).collect();
+            let image = IntervalDepthImage::from_depth(k.width(), k.height(), &depth, |z| {
+                (0.9 * z, 1.2 * z, 0.8)
+            })
+            .unwrap();
+            let frame = DepthFrame::new(k, pose, image).unwrap();
+            let pixels: Vec<PixelEvidence> = (0..n)
+                .map(|i| {
+                    frame.image().pixel(i).map_or(PixelEvidence::NONE, |p| {
+                        PixelEvidence::new(p, &model, &operator, f32::INFINITY, half_diagonal)
+                    })
+                })
+                .collect();
+            let tiles = TileReach::new(&pixels, k.width(), k.height());
+            let camera = CameraView::new(&frame, &resolution);
+            let frustum = frustum_box(&frame, &resolution, tiles.max_reach).unwrap();
+            let kept = camera.observed_blocks(&frustum, &tiles);
+            let all: Vec<BlockKey> = frustum.blocks().collect();
+            assert!(kept.len() < all.len(), "frame {index}: nothing culled");
+            let mut with_evidence = 0;
+            for key in all {
+                let evidence =
+                    camera.block_evidence(key, &pixels, &model, &operator, half_diagonal);
+                if evidence.is_some() {
+                    with_evidence += 1;
+                    assert!(
+                        kept.binary_search_by_key(&(key.z, key.y, key.x), |k| (k.z, k.y, k.x))
+                            .is_ok(),
+                        "frame {index}: block {key:?} has evidence but was culled"
+                    );
+                }
+            }
+            assert!(with_evidence > 0, "frame {index} observes nothing");
+        }
+    }
 }

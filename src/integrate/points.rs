@@ -3,7 +3,8 @@ use rayon::prelude::*;
 
 use super::cloud::PointCloud;
 use super::evidence::{
-    EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence, merge_max, raise,
+    EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence, check_ray_length, merge_max,
+    raise,
 };
 use super::raywalk::walk_ray;
 use crate::error::{Error, Result};
@@ -20,7 +21,8 @@ const CHUNK: usize = 1024;
 /// range-dependent Gaussian kernel, to its neighbours. Rays longer than `max_range` are cut
 /// there and give free evidence only. Non-finite points are skipped and counted.
 ///
-/// Errors (before any work): a finite point or cut end point outside the key range.
+/// Errors (before any work): a finite point or cut end point outside the key range, or a ray
+/// (cut at `max_range`) longer than [`IntegrationOptions::MAX_RAY_VOXELS`].
 pub fn cloud_evidence(
     cloud: &PointCloud,
     resolution: &Resolution,
@@ -32,20 +34,25 @@ pub fn cloud_evidence(
     let origin = cloud.origin();
     let origin_key = resolution.key_of(&origin)?;
     let ray_of = |p: &Point3<f64>| Ray::new(&origin, p, options.max_range);
-    // Validate every end key first, so that a bad point fails the call before any work. Rays
-    // are made on the fly, here and below, so memory does not grow with the cloud.
+    // Validate every end key and ray length first, so that a bad point fails the call before
+    // any work. Rays are made on the fly, here and below, so memory does not grow with the
+    // cloud.
+    let too_long = |ray: &Ray| check_ray_length(ray.range, resolution.size()).is_err();
     if let Some(ray) = cloud
         .points()
         .par_iter()
         .filter_map(ray_of)
-        .find_first(|ray| resolution.try_key_of(&ray.end).is_none())
+        .find_first(|ray| resolution.try_key_of(&ray.end).is_none() || too_long(ray))
     {
-        return Err(Error::OutOfKeyRange {
-            x: ray.end.x,
-            y: ray.end.y,
-            z: ray.end.z,
-            resolution: resolution.size(),
-        });
+        if resolution.try_key_of(&ray.end).is_none() {
+            return Err(Error::OutOfKeyRange {
+                x: ray.end.x,
+                y: ray.end.y,
+                z: ray.end.z,
+                resolution: resolution.size(),
+            });
+        }
+        check_ray_length(ray.range, resolution.size())?;
     }
     // `fold` keeps one partial scan per piece of work that rayon schedules (a few per thread,
     // balanced by work stealing); `max` combines them exactly, so neither the split nor the

@@ -3,7 +3,7 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 use super::cloud::PointCloud;
-use super::evidence::{IntegrationOptions, IntegrationStats};
+use super::evidence::{IntegrationOptions, IntegrationStats, check_ray_length};
 use super::octomap_walk::walk_ray_octomap;
 use crate::error::{Error, Result};
 use crate::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
@@ -122,7 +122,8 @@ const CHUNK: usize = 1024;
 /// traversal, rays longer than `max_range` cut there and clearing only. `include` selects the
 /// points that belong to the scan (all, or one confidence cut).
 ///
-/// Errors (before any work): a finite point outside the key range.
+/// Errors (before any work): a finite point outside the key range, or a ray (cut at
+/// `max_range`) longer than [`IntegrationOptions::MAX_RAY_VOXELS`].
 pub fn scan_sets(
     cloud: &PointCloud,
     resolution: &Resolution,
@@ -147,6 +148,18 @@ pub fn scan_sets(
             z: p.z,
             resolution: resolution.size(),
         });
+    }
+    let cut = |p: &Point3<f64>| {
+        let range = (p - origin).norm();
+        options.max_range.map_or(range, |max| range.min(max))
+    };
+    if let Some(p) = cloud
+        .points()
+        .par_iter()
+        .filter(|p| finite(p))
+        .find_first(|p| check_ray_length(cut(p), resolution.size()).is_err())
+    {
+        check_ray_length(cut(p), resolution.size())?;
     }
     let single = |p: &Point3<f64>| [p.x as f32, p.y as f32, p.z as f32];
     let origin32 = single(&origin);

@@ -3,6 +3,7 @@ use std::path::Path;
 
 use nalgebra::Point3;
 
+use super::bounded::read_line;
 use crate::error::{Error, Result};
 use crate::integrate::PointCloud;
 
@@ -18,6 +19,16 @@ pub fn read_text_cloud(path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
         path: path.to_path_buf(),
         source,
     })?;
+    parse_cloud(BufReader::new(file), path, origin)
+}
+
+/// Parses a text point cloud held in memory; see [`read_text_cloud`]. Errors name the path
+/// `<memory>`.
+pub fn parse_text_cloud(bytes: &[u8], origin: Point3<f64>) -> Result<PointCloud> {
+    parse_cloud(bytes, Path::new("<memory>"), origin)
+}
+
+fn parse_cloud(mut reader: impl BufRead, path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
     let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
         line,
@@ -26,19 +37,17 @@ pub fn read_text_cloud(path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
     let mut points = Vec::new();
     let mut confidence = Vec::new();
     let mut columns = None;
-    let mut text = String::new();
-    let mut reader = BufReader::new(file);
+    let mut bytes = Vec::new();
     let mut line_number = 0;
     loop {
-        text.clear();
-        let read = reader.read_line(&mut text).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        if read == 0 {
+        // Bytes, not `read_line`: a binary file is a parse error naming the line, not an I/O
+        // error.
+        if read_line(&mut reader, &mut bytes, path, line_number + 1)? == 0 {
             break;
         }
         line_number += 1;
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|_| parse_error(line_number, "not UTF-8 text (a binary file?)".into()))?;
         let line = text.trim();
         if line.is_empty() || line.starts_with('#') {
             continue;
@@ -49,10 +58,10 @@ pub fn read_text_cloud(path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter(|f| !f.is_empty())
         {
-            if count == 4 {
-                return Err(parse_error(line_number, "more than 4 values".into()));
-            }
-            values[count] = field
+            let slot = values
+                .get_mut(count)
+                .ok_or_else(|| parse_error(line_number, "more than 4 values".into()))?;
+            *slot = field
                 .parse()
                 .map_err(|_| parse_error(line_number, format!("`{field}` is not a number")))?;
             count += 1;
@@ -73,16 +82,17 @@ pub fn read_text_cloud(path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
             }
             _ => {}
         }
-        points.push(Point3::new(values[0], values[1], values[2]));
+        let [x, y, z, c] = values;
+        points.push(Point3::new(x, y, z));
         if count == 4 {
-            let c = values[3] as f32;
-            if !(0.0..=1.0).contains(&c) {
+            let confidence_f32 = c as f32;
+            if !(0.0..=1.0).contains(&confidence_f32) {
                 return Err(parse_error(
                     line_number,
-                    format!("confidence {} is outside [0, 1]", values[3]),
+                    format!("confidence {c} is outside [0, 1]"),
                 ));
             }
-            confidence.push(c);
+            confidence.push(confidence_f32);
         }
     }
     let cloud = PointCloud::new(origin, points)?;

@@ -14,6 +14,7 @@
 //! | 36..40 | CRC32 of bytes 0..36 followed by the body |
 //! | 40.. | body (postcard) |
 
+use std::io::Read;
 use std::path::Path;
 
 use serde::Serialize;
@@ -82,10 +83,7 @@ pub struct MapHeader {
 
 /// Reads and checks a map file's header and checksum without decoding the body.
 pub fn read_header(path: &Path) -> Result<MapHeader> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_file(path)?;
     split(&bytes)
         .map(|(header, _)| header)
         .map_err(|reason| Error::Format {
@@ -122,58 +120,62 @@ pub(crate) fn encode<T: Serialize>(
 
 /// Checks magic, version, declared length and checksum; returns the header and the body.
 pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
-    if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+    if !bytes.starts_with(MAGIC) {
         return Err(FormatError::BadMagic);
     }
-    if bytes.len() < HEADER_LEN {
+    let Some((header, body)) = bytes.split_first_chunk::<HEADER_LEN>() else {
         return Err(FormatError::Length {
             declared: 0,
             actual: 0,
         });
-    }
-    let u64_at = |at: usize| {
-        let mut b = [0u8; 8];
-        b.copy_from_slice(&bytes[at..at + 8]);
-        u64::from_le_bytes(b)
     };
-    let version = u16::from_le_bytes([bytes[8], bytes[9]]);
+    let version = u16::from_le_bytes(field(header, 8));
     if version != VERSION {
         return Err(FormatError::UnsupportedVersion(version));
     }
-    let body_len = u64_at(28);
-    let actual = (bytes.len() - HEADER_LEN) as u64;
+    let body_len = u64::from_le_bytes(field(header, 28));
+    let actual = body.len() as u64;
     if body_len != actual {
         return Err(FormatError::Length {
             declared: body_len,
             actual,
         });
     }
-    let body = &bytes[HEADER_LEN..];
-    let stored = u32::from_le_bytes([bytes[36], bytes[37], bytes[38], bytes[39]]);
+    let stored = u32::from_le_bytes(field(header, 36));
     let mut crc = crc32fast::Hasher::new();
-    crc.update(&bytes[..36]);
+    crc.update(header.get(..36).unwrap_or_default());
     crc.update(body);
     let computed = crc.finalize();
     if stored != computed {
         return Err(FormatError::Checksum { stored, computed });
     }
-    let kind = MapKind::from_code(bytes[10])
-        .ok_or_else(|| FormatError::Invalid(format!("unknown map kind code {}", bytes[10])))?;
-    let parameter = f64::from_bits(u64_at(12));
-    let operator = match bytes[11] {
+    let [kind_code, operator_code] = field(header, 10);
+    let kind = MapKind::from_code(kind_code)
+        .ok_or_else(|| FormatError::Invalid(format!("unknown map kind code {kind_code}")))?;
+    let parameter = f64::from_le_bytes(field(header, 12));
+    let operator = match operator_code {
         NO_OPERATOR => None,
         code => Some(family_from_code(code, parameter)?),
     };
+    let resolution = f64::from_le_bytes(field(header, 20));
     Ok((
         MapHeader {
             version,
             kind,
             operator,
-            resolution: f64::from_bits(u64_at(20)),
+            resolution,
             body_len,
         },
         body,
     ))
+}
+
+/// `N` header bytes from offset `at` (the offsets used are constants inside the header).
+fn field<const N: usize>(header: &[u8; HEADER_LEN], at: usize) -> [u8; N] {
+    header
+        .get(at..at + N)
+        .and_then(|bytes| bytes.try_into().ok())
+        .unwrap_or([0; N])
 }
 
 /// The file methods every map has, given its `to_bytes` and `decode`: `from_bytes`, an atomic
@@ -208,14 +210,51 @@ pub(crate) fn load_with<T>(
     path: &Path,
     decode: impl FnOnce(&[u8]) -> Result<T, FormatError>,
 ) -> Result<T> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_file(path)?;
     decode(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
         reason,
     })
+}
+
+/// Reads a map file header first: a file without the magic, or whose size is not the header's
+/// declared length, is refused before its body is read (so a wrong path to a huge file, or a
+/// device such as `/dev/zero`, costs 40 bytes). At most the declared length is read even from a
+/// stream, and memory grows only with the bytes that actually arrive.
+fn read_file(path: &Path) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::with_capacity(HEADER_LEN);
+    (&mut file)
+        .take(HEADER_LEN as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    let Ok(header) = <&[u8; HEADER_LEN]>::try_from(bytes.as_slice()) else {
+        // Too short: `split` names the problem.
+        return Ok(bytes);
+    };
+    if !header.starts_with(MAGIC) {
+        return Ok(bytes);
+    }
+    let declared = u64::from_le_bytes(field(header, 28));
+    let metadata = file.metadata().map_err(io)?;
+    if metadata.is_file() {
+        let actual = metadata.len().saturating_sub(HEADER_LEN as u64);
+        if actual != declared {
+            return Err(Error::Format {
+                path: path.to_path_buf(),
+                reason: FormatError::Length { declared, actual },
+            });
+        }
+    }
+    // One byte more than declared, so that a longer stream is a length error, not a long read.
+    file.take(declared.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    Ok(bytes)
 }
 
 /// Decodes map bytes held in memory.

@@ -41,15 +41,31 @@ impl MiddleburyCalib {
 
 /// Reads a Middlebury `calib.txt`.
 pub fn read_calib(path: &Path) -> Result<MiddleburyCalib> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = super::bounded::read_small(path)?;
+    calib_from(&bytes, path)
+}
+
+/// Parses the bytes of a Middlebury `calib.txt` held in memory; see [`read_calib`]. Errors name
+/// the path `<memory>`.
+pub fn parse_calib(bytes: &[u8]) -> Result<MiddleburyCalib> {
+    calib_from(bytes, Path::new("<memory>"))
+}
+
+fn calib_from(bytes: &[u8], path: &Path) -> Result<MiddleburyCalib> {
     let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
         line,
         message,
     };
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let line = bytes
+            .iter()
+            .take(e.valid_up_to())
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1;
+        parse_error(line, "not UTF-8 text (a binary file?)".into())
+    })?;
     let mut values: std::collections::HashMap<String, (usize, String)> = Default::default();
     for (index, line) in text.lines().enumerate() {
         if let Some((key, value)) = line.split_once('=') {
@@ -105,14 +121,30 @@ pub fn read_calib(path: &Path) -> Result<MiddleburyCalib> {
 
 /// Reads an 8-bit grayscale or RGB(A) PNG as a [`GrayImage`].
 pub fn read_gray_png(path: &Path) -> Result<GrayImage> {
-    let io = |source| Error::Io {
+    let reader = image::ImageReader::open(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let decoded = image::ImageReader::open(path)
-        .map_err(io)?
+    })?;
+    gray_from(reader, path)
+}
+
+/// Decodes an 8-bit grayscale or RGB(A) PNG held in memory; see [`read_gray_png`]. Errors name
+/// the path `<memory>`.
+pub fn decode_gray_png(bytes: &[u8]) -> Result<GrayImage> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    gray_from(reader, Path::new("<memory>"))
+}
+
+fn gray_from<R: std::io::BufRead + std::io::Seek>(
+    reader: image::ImageReader<R>,
+    path: &Path,
+) -> Result<GrayImage> {
+    let decoded = reader
         .with_guessed_format()
-        .map_err(io)?
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
         .decode()
         .map_err(|e| Error::Parse {
             path: path.to_path_buf(),

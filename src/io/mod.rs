@@ -1,7 +1,12 @@
 //! Reading and writing files: native map files, text point clouds, RGB-D frames and OctoMap's
 //! formats.
+//!
+//! Readers take bytes from anywhere, so this module may not index or slice: every access to
+//! file bytes is checked (`get`, `split_at_checked`, patterns), and a bad file is an error.
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 
 mod atomic;
+mod bounded;
 mod cloud_text;
 mod fuzzy_file;
 mod logodds_file;
@@ -16,5 +21,5 @@ mod stored_blocks;
 pub mod views;
 
 pub use atomic::write_atomic;
-pub use cloud_text::read_text_cloud;
+pub use cloud_text::{parse_text_cloud, read_text_cloud};
 pub use mapfile::{MapHeader, MapKind, read_header};

@@ -25,10 +25,7 @@ pub struct FloatImage {
 
 /// Reads a one-channel PFM file.
 pub fn read_pfm(path: &Path) -> Result<FloatImage> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::io::bounded::read_regular(path)?;
     parse_pfm(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
         reason,
@@ -57,7 +54,9 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<FloatImage, FormatError> {
         if start == position {
             return Err(invalid("PFM header is incomplete"));
         }
-        Ok(&bytes[start..position])
+        bytes
+            .get(start..position)
+            .ok_or_else(|| invalid("PFM header is incomplete"))
     };
     let magic = token()?;
     match magic {
@@ -100,10 +99,10 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<FloatImage, FormatError> {
         return Err(FormatError::Length { declared, actual });
     }
     let little_endian = scale < 0.0;
-    let samples: Vec<f32> = bytes[body_start..]
-        .chunks_exact(4)
-        .map(|c| {
-            let b = [c[0], c[1], c[2], c[3]];
+    let (words, _) = bytes.get(body_start..).unwrap_or_default().as_chunks::<4>();
+    let samples: Vec<f32> = words
+        .iter()
+        .map(|&b| {
             if little_endian {
                 f32::from_le_bytes(b)
             } else {

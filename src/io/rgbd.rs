@@ -23,16 +23,30 @@ pub struct DepthImage {
 
 /// Reads a 16-bit PNG of depth in millimetres.
 pub fn read_depth_png_mm(path: &Path) -> Result<DepthImage> {
+    let reader = image::ImageReader::open(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    depth_png_from(reader, path)
+}
+
+/// Decodes a 16-bit PNG of depth in millimetres held in memory; see [`read_depth_png_mm`].
+/// Errors name the path `<memory>`.
+pub fn decode_depth_png_mm(bytes: &[u8]) -> Result<DepthImage> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    depth_png_from(reader, Path::new("<memory>"))
+}
+
+fn depth_png_from<R: std::io::BufRead + std::io::Seek>(
+    reader: image::ImageReader<R>,
+    path: &Path,
+) -> Result<DepthImage> {
     let format = |message: String| Error::Parse {
         path: path.to_path_buf(),
         line: 0,
         message,
     };
-    let decoded = image::ImageReader::open(path)
-        .map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?
+    let decoded = reader
         .with_guessed_format()
         .map_err(|source| Error::Io {
             path: path.to_path_buf(),
@@ -61,48 +75,94 @@ pub fn read_depth_png_mm(path: &Path) -> Result<DepthImage> {
 
 /// Reads a whitespace-separated text matrix of `rows × cols` numbers.
 fn read_matrix(path: &Path, rows: usize, cols: usize) -> Result<Vec<f64>> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let bytes = super::bounded::read_small(path)?;
+    matrix_from(&bytes, path, rows, cols)
+}
+
+/// Parses a whitespace-separated text matrix of `rows × cols` numbers; `path` names it in errors.
+fn matrix_from(bytes: &[u8], path: &Path, rows: usize, cols: usize) -> Result<Vec<f64>> {
+    let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
-        source,
-    })?;
+        line,
+        message,
+    };
     let mut values = Vec::with_capacity(rows * cols);
-    for (line_index, line) in text.lines().enumerate() {
+    for (line_index, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = std::str::from_utf8(line)
+            .map_err(|_| parse_error(line_index + 1, "not UTF-8 text (a binary file?)".into()))?;
         for field in line.split_whitespace() {
-            let value: f64 = field.parse().map_err(|_| Error::Parse {
-                path: path.to_path_buf(),
-                line: line_index + 1,
-                message: format!("`{field}` is not a number"),
-            })?;
+            let value: f64 = field
+                .parse()
+                .map_err(|_| parse_error(line_index + 1, format!("`{field}` is not a number")))?;
+            // Stop early: a long file of numbers must not grow the vector without bound.
+            if values.len() == rows * cols {
+                return Err(parse_error(
+                    line_index + 1,
+                    format!("more than {rows}×{cols} numbers"),
+                ));
+            }
             values.push(value);
         }
     }
     if values.len() != rows * cols {
-        return Err(Error::Parse {
-            path: path.to_path_buf(),
-            line: 0,
-            message: format!("expected {rows}×{cols} numbers, found {}", values.len()),
-        });
+        return Err(parse_error(
+            0,
+            format!("expected {rows}×{cols} numbers, found {}", values.len()),
+        ));
     }
     Ok(values)
 }
 
 /// Reads a `frame-N.pose.txt`: a row-major 4×4 `world_from_camera` matrix.
 pub fn read_pose_txt(path: &Path) -> Result<Isometry3<f64>> {
-    let values = read_matrix(path, 4, 4)?;
+    pose_from(read_matrix(path, 4, 4)?)
+}
+
+/// Parses the bytes of a `frame-N.pose.txt` held in memory; see [`read_pose_txt`]. Errors name
+/// the path `<memory>`.
+pub fn parse_pose_txt(bytes: &[u8]) -> Result<Isometry3<f64>> {
+    pose_from(matrix_from(bytes, Path::new("<memory>"), 4, 4)?)
+}
+
+fn pose_from(values: Vec<f64>) -> Result<Isometry3<f64>> {
+    let values: [f64; 16] = values.try_into().map_err(|v: Vec<f64>| {
+        Error::InvalidPose(format!("expected 4×4 numbers, found {}", v.len()))
+    })?;
     pose_from_matrix(&Matrix4::from_row_slice(&values))
 }
 
 /// Reads a `camera-intrinsics.txt` (row-major 3×3 K) for images of `width × height`.
 pub fn read_intrinsics_txt(path: &Path, width: u32, height: u32) -> Result<PinholeIntrinsics> {
-    let k = read_matrix(path, 3, 3)?;
-    if k[1].abs() > 1e-9 || k[3].abs() > 1e-9 || k[6].abs() > 1e-9 || k[7].abs() > 1e-9 {
+    intrinsics_from(&read_matrix(path, 3, 3)?, path, width, height)
+}
+
+/// Parses the bytes of a `camera-intrinsics.txt` held in memory; see [`read_intrinsics_txt`].
+/// Errors name the path `<memory>`.
+pub fn parse_intrinsics_txt(bytes: &[u8], width: u32, height: u32) -> Result<PinholeIntrinsics> {
+    let path = Path::new("<memory>");
+    intrinsics_from(&matrix_from(bytes, path, 3, 3)?, path, width, height)
+}
+
+fn intrinsics_from(k: &[f64], path: &Path, width: u32, height: u32) -> Result<PinholeIntrinsics> {
+    let &[fx, skew, cx, zero_10, fy, cy, zero_20, zero_21, _] = k else {
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: 0,
+            message: format!("expected 3×3 numbers, found {}", k.len()),
+        });
+    };
+    // Written so that NaN fails too.
+    if ![skew, zero_10, zero_20, zero_21]
+        .iter()
+        .all(|v| v.abs() <= 1e-9)
+    {
         return Err(Error::Parse {
             path: path.to_path_buf(),
             line: 0,
             message: "K must be upper triangular without skew: [fx 0 cx; 0 fy cy; 0 0 1]".into(),
         });
     }
-    PinholeIntrinsics::new(width, height, k[0], k[4], k[2], k[5])
+    PinholeIntrinsics::new(width, height, fx, fy, cx, cy)
 }
 
 /// Kinect (structured light) depth noise, σ in metres at depth `z` (Nguyen, Izadi and Lovell,

@@ -107,10 +107,7 @@ impl BtMap {
 
 /// Reads an OctoMap binary tree file (`.bt`); see [`decode_bt`] for what is checked.
 pub fn read_bt(path: &Path) -> Result<BtMap> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::io::bounded::read_regular(path)?;
     decode_bt(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
         reason,

@@ -46,10 +46,7 @@ const QUATERNION_NORM_TOLERANCE: f64 = 1e-3;
 /// Every count is checked against the bytes left before anything is allocated, and the file must
 /// end exactly after the last edge; any damage is an [`Error::Format`].
 pub fn read_scan_graph(path: &Path) -> Result<Vec<ScanNode>> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::io::bounded::read_regular(path)?;
     decode_scan_graph(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
         reason,

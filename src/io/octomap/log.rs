@@ -16,6 +16,7 @@ use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
 use super::scan::ScanNode;
 use crate::error::{Error, Result};
 use crate::geometry::validate_pose;
+use crate::io::bounded::read_line;
 
 /// Reads an OctoMap scan log: a `NODE x y z roll pitch yaw` line starts each scan and is followed
 /// by its points, one `x y z` per line in the sensor frame. Fields are separated by whitespace;
@@ -28,24 +29,32 @@ use crate::geometry::validate_pose;
 ///
 /// Unlike OctoMap, which silently skips lines that start with a space, indented lines are read.
 pub fn read_scan_log(path: &Path) -> Result<Vec<ScanNode>> {
-    let io = |source| Error::Io {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
-    };
+    })?;
+    parse_log(BufReader::new(file), path)
+}
+
+/// Parses the bytes of an OctoMap scan log held in memory; see [`read_scan_log`]. Errors name
+/// the path `<memory>`.
+pub fn parse_scan_log(bytes: &[u8]) -> Result<Vec<ScanNode>> {
+    parse_log(bytes, Path::new("<memory>"))
+}
+
+fn parse_log(mut reader: impl BufRead, path: &Path) -> Result<Vec<ScanNode>> {
     let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
         line,
         message,
     };
-    let mut reader = BufReader::new(std::fs::File::open(path).map_err(io)?);
     let mut nodes: Vec<ScanNode> = Vec::new();
     let mut bytes = Vec::new();
     let mut line_number = 0;
     loop {
-        bytes.clear();
         // Bytes, not `read_line`: a binary file must be a parse error naming the line, not an
         // I/O error.
-        if reader.read_until(b'\n', &mut bytes).map_err(io)? == 0 {
+        if read_line(&mut reader, &mut bytes, path, line_number + 1)? == 0 {
             break;
         }
         line_number += 1;

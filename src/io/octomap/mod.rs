@@ -38,5 +38,5 @@ mod scan;
 pub use bt::{BtLeaf, BtMap, decode_bt, read_bt};
 pub use bt_write::{encode_bt, write_bt, write_bt_max_likelihood};
 pub use graph::{decode_scan_graph, read_scan_graph};
-pub use log::read_scan_log;
+pub use log::{parse_scan_log, read_scan_log};
 pub use scan::ScanNode;

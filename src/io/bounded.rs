@@ -1,0 +1,80 @@
+//! Reading files without trusting them to be small: text formats have a size or line-length
+//! cap, so a wrong path (a video, a device such as `/dev/zero`) is an error, not an endless
+//! read.
+
+use std::io::{BufRead, Read};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// Longest line a text format may have (1 MiB; real lines are under 200 bytes).
+pub(crate) const MAX_LINE_BYTES: u64 = 1 << 20;
+
+/// Largest small text file (a calibration, a pose, intrinsics): 1 MiB.
+pub(crate) const MAX_SMALL_FILE_BYTES: u64 = 1 << 20;
+
+/// Reads a whole small text file, refusing one longer than `MAX_SMALL_FILE_BYTES`.
+pub(crate) fn read_small(path: &Path) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SMALL_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_SMALL_FILE_BYTES {
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: 0,
+            message: format!(
+                "longer than {MAX_SMALL_FILE_BYTES} bytes: not a calibration, pose or intrinsics file"
+            ),
+        });
+    }
+    Ok(bytes)
+}
+
+/// Reads the next line (with its `\n`) into `line`, at most [`MAX_LINE_BYTES`]; returns the
+/// bytes read (0 at the end). A longer line is an error naming `line_number`.
+pub(crate) fn read_line(
+    reader: &mut impl BufRead,
+    line: &mut Vec<u8>,
+    path: &Path,
+    line_number: usize,
+) -> Result<usize> {
+    line.clear();
+    let read = reader
+        .take(MAX_LINE_BYTES + 1)
+        .read_until(b'\n', line)
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    if read as u64 > MAX_LINE_BYTES {
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: line_number,
+            message: format!("line longer than {MAX_LINE_BYTES} bytes: not a text file?"),
+        });
+    }
+    Ok(read)
+}
+
+/// Reads a whole binary file, which must be a regular file: its size is then known and bounds
+/// the allocation, where a device such as `/dev/zero` would never end.
+pub(crate) fn read_regular(path: &Path) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let metadata = std::fs::metadata(path).map_err(io)?;
+    if !metadata.is_file() && !metadata.is_dir() {
+        return Err(io(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a device or a pipe?)",
+        )));
+    }
+    std::fs::read(path).map_err(io)
+}
