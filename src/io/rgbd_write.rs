@@ -88,8 +88,8 @@ pub fn write_gray_png(path: &Path, width: u32, height: u32, pixels: &[f32]) -> R
 pub fn write_pose_txt(path: &Path, pose: &Isometry3<f64>) -> Result<()> {
     let m = pose.to_homogeneous();
     let mut text = String::new();
-    for r in 0..4 {
-        let row: Vec<String> = (0..4).map(|c| format!("{:.9e}", m[(r, c)])).collect();
+    for row in m.row_iter() {
+        let row: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
         let _ = writeln!(text, "{}", row.join("\t"));
     }
     write_atomic(path, text.as_bytes())

@@ -127,15 +127,17 @@ pub fn render_view(
         let (a, b) = axes(key);
         let i = (b - lo.1) as usize * columns + (a - lo.0) as usize;
         let m = config.measures(m);
-        pixels[i] = Some(match pixels[i] {
-            None => m,
-            Some(old) => combine(old, m, color),
-        });
+        if let Some(pixel) = pixels.get_mut(i) {
+            *pixel = Some(match *pixel {
+                None => m,
+                Some(old) => combine(old, m, color),
+            });
+        }
     }
     let image =
         image::RgbImage::from_fn((columns as u32) * scale, (rows as u32) * scale, |x, y| {
             let (a, b) = ((x / scale) as usize, rows - 1 - (y / scale) as usize);
-            image::Rgb(match pixels[b * columns + a] {
+            image::Rgb(match pixels.get(b * columns + a).copied().flatten() {
                 None => [255, 255, 255],
                 Some(m) => match color {
                     ViewColor::Class => class_color(m.class),
@@ -203,12 +205,17 @@ fn ramp(value: f32) -> [u8; 3] {
         [250.0, 220.0, 40.0],
     ];
     let s = 2.0 * value.clamp(0.0, 1.0);
+    let [low, middle, high] = STOPS;
     let (a, b, f) = if s < 1.0 {
-        (STOPS[0], STOPS[1], s)
+        (low, middle, s)
     } else {
-        (STOPS[1], STOPS[2], s - 1.0)
+        (middle, high, s - 1.0)
     };
-    [0, 1, 2].map(|c| (a[c] + (b[c] - a[c]) * f).round() as u8)
+    let mut out = [0u8; 3];
+    for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
+        *o = (a + (b - a) * f).round() as u8;
+    }
+    out
 }
 
 #[cfg(test)]
