@@ -318,7 +318,7 @@ fn export_of_a_damaged_map_writes_no_tree() {
         "length mismatch",
     );
     assert!(!bt.exists(), "a failed export wrote a tree");
-    fails(&["export", &map], 1, "nothing to export");
+    fails(&["export", &map], 2, "required arguments were not provided");
     let missing = dir.join("no/folder/out.bt");
     fails(
         &["export", &map, "--bt", missing.to_str().unwrap()],
@@ -508,17 +508,13 @@ fn eval_refuses_bad_resolutions_and_operators_before_working() {
 }
 
 #[test]
-fn eval_of_no_pairs_is_an_empty_report() {
-    // Documented: a random flight of zero pairs observes nothing, and every map is empty.
-    let out = fuzzyvox(&["eval", "--scenario", "random", "--pairs", "0", "--json"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+fn eval_of_no_pairs_is_refused() {
+    // A random flight of zero pairs would observe nothing: a usage error, not an empty report.
+    fails(
+        &["eval", "--scenario", "random", "--pairs", "0", "--json"],
+        1,
+        "--pairs must be at least 1",
     );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(report["pairs"], 0);
-    assert_eq!(report["maps"]["fuzzy"]["occupied"], 0);
 }
 
 #[test]
