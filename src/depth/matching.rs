@@ -425,3 +425,213 @@ fn valid_range(ctx: &Context, x: usize) -> (usize, usize) {
     let lo = (first_right - ctx.width as isize + 1).clamp(0, hi as isize) as usize;
     (lo, hi)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A plain reference matcher: the whole cost volume, window sums by explicit loops, and each
+    /// pixel's decision written out from the documented rules.
+    fn reference(left: &CensusImage, right: &CensusImage, params: &MatchParams) -> DisparityMap {
+        let (w, h) = (left.width as isize, left.height as isize);
+        let nd = params.num_disparities as isize;
+        let dmin = params.min_disparity as isize;
+        let (rx, ry) = (
+            params.window_width as isize / 2,
+            params.window_height as isize / 2,
+        );
+        let cost = |x: isize, y: isize, d: isize| -> i32 {
+            let xr = x - dmin - d;
+            if xr < 0 || xr >= w {
+                return i32::from(CENSUS_MAX_COST);
+            }
+            let (l, r) = (
+                left.codes[(y * w + x) as usize],
+                right.codes[(y * w + xr) as usize],
+            );
+            (l ^ r).count_ones() as i32
+        };
+        let sum = |x: isize, y: isize, d: isize| -> i32 {
+            let mut s = 0;
+            for j in -ry..=ry {
+                for k in -rx..=rx {
+                    s += cost((x + k).clamp(0, w - 1), (y + j).clamp(0, h - 1), d);
+                }
+            }
+            s
+        };
+        let table = thresholds(params);
+        let n = (w * h) as usize;
+        let mut out = DisparityMap {
+            width: w as u32,
+            height: h as u32,
+            disparity: vec![f32::NAN; n],
+            range_low: vec![f32::NAN; n],
+            range_high: vec![f32::NAN; n],
+        };
+        for y in 0..h {
+            let sums: Vec<Vec<i32>> = (0..w)
+                .map(|x| (0..nd).map(|d| sum(x, y, d)).collect())
+                .collect();
+            let valid_d = |x: isize, d: isize| (0..w).contains(&(x - dmin - d));
+            // The right image's least cost per right column.
+            let right_least = |xr: isize| {
+                (0..w)
+                    .flat_map(|x| (0..nd).map(move |d| (x, d)))
+                    .filter(|&(x, d)| x - dmin - d == xr)
+                    .map(|(x, d)| sums[x as usize][d as usize])
+                    .min()
+                    .unwrap()
+            };
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                if !left.valid[i] {
+                    continue;
+                }
+                let ds: Vec<isize> = (0..nd).filter(|&d| valid_d(x, d)).collect();
+                let Some(&lo) = ds.first() else { continue };
+                let hi = ds[ds.len() - 1] + 1;
+                let column = &sums[x as usize][lo as usize..hi as usize];
+                let best_cost = *column.iter().min().unwrap();
+                let best = column.iter().position(|&c| c == best_cost).unwrap();
+                let (range, unique) = table[best_cost as usize];
+                let (range, unique) = (i32::from(range), i32::from(unique));
+                let low = column.iter().position(|&c| c <= range).unwrap();
+                let high = column.iter().rposition(|&c| c <= range).unwrap();
+                let best_d = lo + best as isize;
+                let xr = x - dmin - best_d;
+                if !right.valid[(y * w + xr) as usize] {
+                    continue;
+                }
+                if let Some(tolerance) = params.left_right_tolerance {
+                    let target = right_least(xr);
+                    let t = tolerance as isize;
+                    let consistent = (-t..=t).any(|t| {
+                        (0..w).contains(&(x + t))
+                            && (0..nd).contains(&(best_d + t))
+                            && sums[(x + t) as usize][(best_d + t) as usize] == target
+                    });
+                    if !consistent {
+                        continue;
+                    }
+                }
+                let rival = column
+                    .iter()
+                    .enumerate()
+                    .any(|(k, &c)| c < unique && k.abs_diff(best) > 1);
+                if rival {
+                    continue;
+                }
+                let mut offset = 0.0f32;
+                if best > 0 && best + 1 < column.len() {
+                    let (c0, c1, c2) = (
+                        column[best - 1] as f32,
+                        best_cost as f32,
+                        column[best + 1] as f32,
+                    );
+                    let curvature = c0 - 2.0 * c1 + c2;
+                    if curvature > 0.0 {
+                        offset = (0.5 * (c0 - c2) / curvature).clamp(-0.5, 0.5);
+                    }
+                }
+                let base = dmin as f32 + lo as f32;
+                out.disparity[i] = base + best as f32 + offset;
+                out.range_low[i] = base + low as f32;
+                out.range_high[i] = base + high as f32;
+            }
+        }
+        out
+    }
+
+    /// A textured pair: the right image is the left one shifted by a disparity that changes
+    /// across the image, plus noise, with a few pixels without a value.
+    fn pair(width: u32, height: u32, seed: u64) -> (GrayImage, GrayImage) {
+        let mut state = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as u32
+        };
+        let (w, h) = (width as usize, height as usize);
+        let texture: Vec<f32> = (0..(w + 40) * h).map(|_| (next() % 256) as f32).collect();
+        let mut left = vec![0f32; w * h];
+        let mut right = vec![0f32; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let shift = 2 + x * 4 / w.max(1);
+                left[y * w + x] = texture[y * (w + 40) + x + 20 - shift];
+                right[y * w + x] = texture[y * (w + 40) + x + 20] + (next() % 7) as f32;
+            }
+        }
+        for _ in 0..(w * h / 40) {
+            let i = next() as usize % (w * h);
+            left[i] = f32::NAN;
+            let j = next() as usize % (w * h);
+            right[j] = f32::NAN;
+        }
+        (
+            GrayImage::new(width, height, left).unwrap(),
+            GrayImage::new(width, height, right).unwrap(),
+        )
+    }
+
+    #[test]
+    fn matches_the_reference_bit_for_bit() {
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let sizes = [(1, 1), (3, 2), (8, 5), (21, 9), (40, 13)];
+        let disparities = [
+            (0, 1),
+            (0, 5),
+            (0, 16),
+            (-3, 17),
+            (2, 33),
+            (30, 8),
+            (-50, 20),
+        ];
+        let windows = [(1, 1), (3, 5), (9, 9), (15, 15)];
+        let checks = [
+            (0, None, 0.0),
+            (10, Some(1), 0.25),
+            (50, Some(0), 2.0),
+            (10, Some(3), 0.25),
+        ];
+        let mut case = 0u64;
+        for &(width, height) in &sizes {
+            for &(min_disparity, num_disparities) in &disparities {
+                for &(window_width, window_height) in &windows {
+                    let (uniqueness_ratio, left_right_tolerance, range_tolerance) =
+                        checks[case as usize % checks.len()];
+                    case += 1;
+                    let (left, right) = pair(width, height, case);
+                    let params = MatchParams {
+                        min_disparity,
+                        num_disparities,
+                        window_width,
+                        window_height,
+                        uniqueness_ratio,
+                        left_right_tolerance,
+                        range_tolerance,
+                    };
+                    let (lc, rc) = (census_transform(&left), census_transform(&right));
+                    let fast = match_census(&lc, &rc, &params);
+                    let slow = reference(&lc, &rc, &params);
+                    let context = format!("{width}x{height}, {params:?}");
+                    assert_eq!(bits(&fast.disparity), bits(&slow.disparity), "{context}");
+                    assert_eq!(bits(&fast.range_low), bits(&slow.range_low), "{context}");
+                    assert_eq!(bits(&fast.range_high), bits(&slow.range_high), "{context}");
+                }
+            }
+        }
+        // The pairs are matchable: the reference finds most pixels on the larger ones.
+        let (left, right) = pair(40, 13, 99);
+        let params = MatchParams {
+            num_disparities: 16,
+            ..MatchParams::default()
+        };
+        let map = reference(&census_transform(&left), &census_transform(&right), &params);
+        assert!(map.density() > 0.5, "{}", map.density());
+    }
+}
