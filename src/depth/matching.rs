@@ -28,9 +28,6 @@ const LANES: usize = 16;
 /// Bytes of one census string.
 const CODE_BYTES: usize = std::mem::size_of::<CensusCode>();
 
-/// "No disparity" in a row's best disparities.
-const NO_DISPARITY: u32 = u32::MAX;
-
 /// Everything a band needs, shared read-only between threads.
 struct Context<'a> {
     left: &'a CensusImage,
@@ -167,10 +164,6 @@ struct Band {
     column: Vec<u8>,
     /// One column of window sums, for the same border columns.
     border: Vec<i16>,
-    /// The horizontal running sum.
-    running: Vec<i16>,
-    /// The current row's best disparity index per pixel, [`NO_DISPARITY`] when none.
-    best: Vec<u32>,
 }
 
 /// Matches rows `y0..y1` into `out`: the band's rows of the disparity, range-low and range-high
@@ -186,8 +179,6 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 3]) {
         right_cost: vec![i16::MAX; w + stride],
         column: vec![0; stride],
         border: vec![0; stride],
-        running: vec![0; stride],
-        best: vec![NO_DISPARITY; w],
     };
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds row first + k (clamped). The
     // ring starts at zero, so entering a row only adds it.
@@ -315,24 +306,29 @@ fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize) {
         ..
     } = band;
     let ring = &mut ring[slot * w * stride..(slot + 1) * w * stride];
-    let columns = ring
-        .chunks_exact_mut(stride)
-        .zip(vertical.chunks_exact_mut(stride));
-    for (x, (&code, (old, vertical))) in left.iter().zip(columns).enumerate() {
+    // Right column x - dmin - d sits at plane index `start(x) + d`. With at least one
+    // searchable disparity, `start .. start + stride` stays within one stride of the image's
+    // plane indices, so the reads are in bounds.
+    let start = |x: usize| stride as isize + w as isize - 1 - x as isize + ctx.min_disparity;
+    let (full_lo, full_hi) = full_columns(ctx);
+    if full_hi > full_lo {
+        let [p0, p1, p2, p3] = &*planes;
+        enter_full_columns(
+            &left[full_lo..full_hi],
+            [p0, p1, p2, p3],
+            start(full_lo) as usize,
+            &ctx.keep,
+            &mut ring[full_lo * stride..full_hi * stride],
+            &mut vertical[full_lo * stride..full_hi * stride],
+        );
+    }
+    // The border columns: disparities whose right pixel lies outside the image cost the most.
+    for x in (0..full_lo).chain(full_hi..w) {
+        let (code, old) = (left[x], &mut ring[x * stride..(x + 1) * stride]);
+        let vertical = &mut vertical[x * stride..(x + 1) * stride];
         let (lo, hi) = valid_range(ctx, x);
-        let code = code.to_le_bytes();
-        // Right column x - dmin - d sits at plane index `start + d`. With at least one
-        // searchable disparity, `start .. start + stride` stays within one stride of the
-        // image's plane indices, so the reads are in bounds.
-        let start = (stride as isize + w as isize - 1 - x as isize + ctx.min_disparity) as usize;
-        if lo == 0 && hi == nd {
-            let q = plane_slices(planes, start, stride);
-            enter_full_column(code, q, &ctx.keep, old, vertical);
-            continue;
-        }
-        // A border column: disparities whose right pixel lies outside the image cost the most.
         if hi > lo {
-            let [q0, q1, q2, q3] = plane_slices(planes, start, stride);
+            let [q0, q1, q2, q3] = plane_slices(planes, start(x) as usize, stride);
             let steps = column
                 .chunks_exact_mut(LANES)
                 .zip(q0.chunks_exact(LANES))
@@ -340,7 +336,7 @@ fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize) {
                 .zip(q2.chunks_exact(LANES))
                 .zip(q3.chunks_exact(LANES));
             for ((((costs, q0), q1), q2), q3) in steps {
-                costs.copy_from_slice(&chunk_costs(code, [q0, q1, q2, q3]));
+                costs.copy_from_slice(&chunk_costs(code.to_le_bytes(), [q0, q1, q2, q3]));
             }
         }
         column[..lo].fill(CENSUS_MAX_COST);
@@ -353,6 +349,29 @@ fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize) {
     }
 }
 
+/// Costs and enters consecutive columns whose disparities are all searchable: column `i` (of
+/// `codes`, `old` and `vertical`, `stride` lanes each) reads the planes from `start - i`.
+/// (Not inlined: on its own, the compiler knows that the slices do not overlap.)
+#[inline(never)]
+fn enter_full_columns(
+    codes: &[CensusCode],
+    planes: [&[u8]; CODE_BYTES],
+    start: usize,
+    keep: &[u8],
+    old: &mut [u8],
+    vertical: &mut [i16],
+) {
+    let stride = keep.len();
+    let columns = old
+        .chunks_exact_mut(stride)
+        .zip(vertical.chunks_exact_mut(stride));
+    for (i, (&code, (old, vertical))) in codes.iter().zip(columns).enumerate() {
+        let at = start - i;
+        let q = planes.map(|plane| &plane[at..at + stride]);
+        enter_full_column(code.to_le_bytes(), q, keep, old, vertical);
+    }
+}
+
 /// Window sums of row `y` from the vertical sums, then per pixel the winner, its checks and the
 /// sub-pixel step, written into `out` (the row of the disparity, range-low and range-high
 /// planes).
@@ -362,57 +381,64 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         vertical,
         sums,
         right_cost,
-        running,
-        best: best_of,
         border,
         ..
     } = band;
-    horizontal_row(vertical, sums, right_cost, running, w, nd, ctx.radius_x);
-    best_of.fill(NO_DISPARITY);
+    horizontal_row(vertical, sums, right_cost, w, nd, ctx.radius_x);
+    let reach = ctx
+        .params
+        .left_right_tolerance
+        .map(|t| t.min(nd as u32) as usize);
     let [disparity, range_low, range_high] = out;
     for plane in [&mut *disparity, &mut *range_low, &mut *range_high] {
         plane.fill(f32::NAN);
     }
     let left_valid = &ctx.left.valid[y * w..(y + 1) * w];
     let right_valid = &ctx.right.valid[y * w..(y + 1) * w];
-    let columns = sums.chunks_exact(stride).zip(left_valid);
-    for (x, (column, &valid)) in columns.enumerate() {
-        if !valid {
-            continue;
-        }
-        let (lo, hi) = valid_range(ctx, x);
-        if hi <= lo {
-            continue;
-        }
-        // The pixel's sums over whole chunks, indexed by disparity index: padding lanes and, at
-        // the border columns, disparities whose right pixel lies outside the image hold
-        // `i16::MAX`, which never wins, never lies in the range and is never a rival.
-        let column = if lo == 0 && hi == nd {
-            column
-        } else {
-            border.fill(i16::MAX);
-            border[lo..hi].copy_from_slice(&column[lo..hi]);
-            &border[..]
-        };
+    // One pixel: its window sums over whole chunks, indexed by disparity index, with padding
+    // lanes and, at the border columns, disparities whose right pixel lies outside the image
+    // at `i16::MAX`, which never wins, never lies in the range and is never a rival;
+    // `[lo, hi)` the searchable disparities.
+    let mut decide = |x: usize, column: &[i16], lo: usize, hi: usize| {
         let scan = scan_column(column, &ctx.thresholds);
         let best_d = scan.best;
         let xr = (x as isize - dmin - best_d as isize) as usize;
-        if !right_valid[xr] {
-            continue;
+        if !right_valid.get(xr).copied().unwrap_or(false) {
+            return;
+        }
+        // Left-right check: the right pixel's best match must lie within the tolerance of this
+        // one, i.e. one of the pairs (x + t, d + t), |t| <= tolerance, which all land on the
+        // same right pixel, must reach the right pixel's least sum. (Ties in the right image
+        // pass when any of the tied matches is close, which saves a second pass.)
+        if let Some(reach) = reach {
+            let target = right_cost[w - 1 - x + best_d];
+            let consistent = target == scan.best_cost
+                || (1..=reach).any(|t| {
+                    let at = |xx: usize, dd: usize| {
+                        (xx < w && dd < nd).then(|| sums[xx * stride + dd]) == Some(target)
+                    };
+                    at(x.wrapping_sub(t), best_d.wrapping_sub(t)) || at(x + t, best_d + t)
+                });
+            if !consistent {
+                return;
+            }
         }
         // Uniqueness: any disparity more than one pixel from the best under the bound, i.e.
-        // more costs under it than the best and its two neighbours account for.
-        let near = &column[best_d.saturating_sub(1)..(best_d + 2).min(stride)];
-        if scan.under_bound > near.iter().filter(|&&c| c < scan.unique_bound).count() {
-            continue;
+        // more sums under it than the best and its two neighbours account for.
+        let at = |d: usize| column.get(d).copied().unwrap_or(i16::MAX);
+        let (before, after) = (at(best_d.wrapping_sub(1)), at(best_d + 1));
+        let near =
+            1 + usize::from(before < scan.unique_bound) + usize::from(after < scan.unique_bound);
+        if scan.under_bound > near {
+            return;
         }
-        // Parabola through the best cost and its two neighbours.
+        // Parabola through the best sum and its two neighbours.
         let mut offset = 0.0f32;
         if best_d > lo && best_d + 1 < hi {
             let (c0, c1, c2) = (
-                f32::from(column[best_d - 1]),
+                f32::from(before),
                 f32::from(scan.best_cost),
-                f32::from(column[best_d + 1]),
+                f32::from(after),
             );
             let curvature = c0 - 2.0 * c1 + c2;
             if curvature > 0.0 {
@@ -426,41 +452,30 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         disparity[x] = base + (best_d - lo) as f32 + offset;
         range_low[x] = base + (scan.low - lo) as f32;
         range_high[x] = base + (scan.high - lo) as f32;
-        best_of[x] = best_d as u32;
+    };
+    let (full_lo, full_hi) = full_columns(ctx);
+    let full = sums[full_lo * stride..full_hi * stride].chunks_exact(stride);
+    for ((x, column), _) in (full_lo..)
+        .zip(full)
+        .zip(&left_valid[full_lo..full_hi])
+        .filter(|(_, v)| **v)
+    {
+        decide(x, column, 0, nd);
     }
-    // Left-right check, once the right image's least costs are complete: the right pixel's best
-    // match must lie within the tolerance of this one, i.e. one of the pairs (x + t, d + t),
-    // |t| <= tolerance, which all land on the same right pixel, must reach the right pixel's
-    // least cost. (Ties in the right image pass when any of the tied matches is close, which
-    // saves a second pass.)
-    if let Some(tolerance) = ctx.params.left_right_tolerance {
-        let reach = tolerance.min(nd as u32) as isize;
-        for (x, &best_d) in best_of.iter().enumerate() {
-            if best_d == NO_DISPARITY {
-                continue;
-            }
-            let best_d = best_d as usize;
-            let target = right_cost[w - 1 - x + best_d];
-            let consistent = (-reach..=reach).any(|t| {
-                let (xx, dd) = (x as isize + t, best_d as isize + t);
-                xx >= 0
-                    && (xx as usize) < w
-                    && dd >= 0
-                    && (dd as usize) < nd
-                    && sums[xx as usize * stride + dd as usize] == target
-            });
-            if !consistent {
-                disparity[x] = f32::NAN;
-                range_low[x] = f32::NAN;
-                range_high[x] = f32::NAN;
-            }
+    for x in (0..full_lo).chain(full_hi..w) {
+        let (lo, hi) = valid_range(ctx, x);
+        if !left_valid[x] || hi <= lo {
+            continue;
         }
+        border.fill(i16::MAX);
+        border[lo..hi].copy_from_slice(&sums[x * stride + lo..x * stride + hi]);
+        decide(x, border, lo, hi);
     }
 }
 
 /// The window sums of one row (`sums`, `width × stride`) from the vertical sums, by a running
 /// sum along the row with the border columns repeated, and the right image's least window sums
-/// (`right_cost`, mirrored). `running` is one column of scratch. Padding lanes hold `i16::MAX`.
+/// (`right_cost`, mirrored). Padding lanes hold `i16::MAX`.
 /// (Not inlined: on its own, the compiler knows that the slices do not overlap and keeps every
 /// step in SIMD registers.)
 #[inline(never)]
@@ -468,67 +483,77 @@ fn horizontal_row(
     vertical: &[i16],
     sums: &mut [i16],
     right_cost: &mut [i16],
-    running: &mut [i16],
     w: usize,
     nd: usize,
     rx: usize,
 ) {
-    let stride = running.len();
+    let stride = sums.len() / w;
     let vertical_at = |x: isize| {
         let x = x.clamp(0, w as isize - 1) as usize;
         &vertical[x * stride..(x + 1) * stride]
     };
     right_cost.fill(i16::MAX);
-    running.fill(0);
+    let (first, rest) = sums.split_at_mut(stride);
+    first.fill(0);
     for k in -(rx as isize)..=(rx as isize) {
-        for (s, &v) in running.iter_mut().zip(vertical_at(k)) {
+        for (s, &v) in first.iter_mut().zip(vertical_at(k)) {
             *s = s.wrapping_add(v);
         }
     }
     // Padding lanes: the vertical sums there are 0, so they stay at `i16::MAX`.
-    running[nd..].fill(i16::MAX);
-    for (x, column) in sums.chunks_exact_mut(stride).enumerate() {
-        let mirrored = &mut right_cost[w - 1 - x..w - 1 - x + stride];
-        if x == 0 {
-            column.copy_from_slice(running);
-            for (r, &s) in mirrored.iter_mut().zip(running.iter()) {
+    first[nd..].fill(i16::MAX);
+    let mut previous: &[i16] = first;
+    for (x, column) in (1..).zip(rest.chunks_exact_mut(stride)) {
+        let add = vertical_at(x as isize + rx as isize);
+        let sub = vertical_at(x as isize - rx as isize - 1);
+        slide(column, previous, add, sub);
+        previous = column;
+    }
+    // The right image's least sums, column by column into the mirrored array, whose window
+    // moves by one lane per column. Consecutive columns would read what the previous one has
+    // just stored one lane off, which the processor cannot forward from its store buffer;
+    // columns eight apart move the window by exactly one register, so go in eight passes.
+    for phase in 0..8.min(w) {
+        for x in (phase..w).step_by(8) {
+            let mirrored = &mut right_cost[w - 1 - x..w - 1 - x + stride];
+            for (r, &s) in mirrored.iter_mut().zip(&sums[x * stride..(x + 1) * stride]) {
                 *r = (*r).min(s);
             }
-        } else {
-            let add = vertical_at(x as isize + rx as isize);
-            let sub = vertical_at(x as isize - rx as isize - 1);
-            slide(running, add, sub, column, mirrored);
         }
     }
 }
 
-/// One column of the running sum: `running += add - sub`, stored into `column` and folded into
-/// the right image's least sums `mirrored`, sixteen lanes at a time.
-#[inline(always)]
-fn slide(running: &mut [i16], add: &[i16], sub: &[i16], column: &mut [i16], mirrored: &mut [i16]) {
-    let steps = running
+/// One column of the running sum, `column = previous + add - sub`, sixteen lanes at a time.
+/// (Not inlined: inlined, the compiler loses track of `column` and `previous` being apart
+/// and compiles it one lane at a time.)
+#[inline(never)]
+fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) {
+    let steps = column
         .chunks_exact_mut(LANES)
+        .zip(previous.chunks_exact(LANES))
         .zip(add.chunks_exact(LANES))
-        .zip(sub.chunks_exact(LANES))
-        .zip(column.chunks_exact_mut(LANES))
-        .zip(mirrored.chunks_exact_mut(LANES));
-    for ((((running, add), sub), column), mirrored) in steps {
-        let (Ok(running), Ok(add), Ok(sub), Ok(column), Ok(mirrored)) = (
-            <&mut [i16; LANES]>::try_from(running),
+        .zip(sub.chunks_exact(LANES));
+    for (((column, previous), add), sub) in steps {
+        let (Ok(column), Ok(previous), Ok(add), Ok(sub)) = (
+            <&mut [i16; LANES]>::try_from(column),
+            <&[i16; LANES]>::try_from(previous),
             <&[i16; LANES]>::try_from(add),
             <&[i16; LANES]>::try_from(sub),
-            <&mut [i16; LANES]>::try_from(column),
-            <&mut [i16; LANES]>::try_from(mirrored),
         ) else {
             continue;
         };
         for k in 0..LANES {
-            let s = running[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
-            running[k] = s;
-            column[k] = s;
-            mirrored[k] = mirrored[k].min(s);
+            column[k] = previous[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
         }
     }
+}
+
+/// The columns `[lo, hi)` whose disparities are all searchable (`x - dmin` in `nd - 1 .. w`).
+fn full_columns(ctx: &Context) -> (usize, usize) {
+    let (w, dmin) = (ctx.width as isize, ctx.min_disparity);
+    let lo = (ctx.disparities as isize - 1 + dmin).clamp(0, w);
+    let hi = (w + dmin).clamp(lo, w);
+    (lo as usize, hi as usize)
 }
 
 /// Disparity indices `[lo, hi)` whose right pixel lies inside the image at column `x`.
