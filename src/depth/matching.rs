@@ -164,6 +164,8 @@ struct Band {
     column: Vec<u8>,
     /// One column of window sums, for the same border columns.
     border: Vec<i16>,
+    /// The current row's matches.
+    found: Vec<Found>,
 }
 
 /// Matches rows `y0..y1` into `out`: the band's rows of the disparity, range-low and range-high
@@ -179,6 +181,7 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 3]) {
         right_cost: vec![i16::MAX; w + stride],
         column: vec![0; stride],
         border: vec![0; stride],
+        found: vec![Found::NONE; w],
     };
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds row first + k (clamped). The
     // ring starts at zero, so entering a row only adds it.
@@ -382,6 +385,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         sums,
         right_cost,
         border,
+        found,
         ..
     } = band;
     horizontal_row(vertical, sums, right_cost, w, nd, ctx.radius_x);
@@ -389,10 +393,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         .params
         .left_right_tolerance
         .map(|t| t.min(nd as u32) as usize);
-    let [disparity, range_low, range_high] = out;
-    for plane in [&mut *disparity, &mut *range_low, &mut *range_high] {
-        plane.fill(f32::NAN);
-    }
+    found.fill(Found::NONE);
     let left_valid = &ctx.left.valid[y * w..(y + 1) * w];
     let right_valid = &ctx.right.valid[y * w..(y + 1) * w];
     // One pixel: its window sums over whole chunks, indexed by disparity index, with padding
@@ -432,26 +433,21 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         if scan.under_bound > near {
             return;
         }
-        // Parabola through the best sum and its two neighbours.
-        let mut offset = 0.0f32;
-        if best_d > lo && best_d + 1 < hi {
-            let (c0, c1, c2) = (
-                f32::from(before),
-                f32::from(scan.best_cost),
-                f32::from(after),
-            );
-            let curvature = c0 - 2.0 * c1 + c2;
-            if curvature > 0.0 {
-                offset = (0.5 * (c0 - c2) / curvature).clamp(-0.5, 0.5);
-            }
-        }
-        // Cost-curve range: the span of all disparities within the tolerance of the best, so a
-        // distant near-tie widens it (an ambiguous match is an uncertain one). (Offsets from
-        // `lo` as integers first, so that the sums round as they always have.)
-        let base = dmin as f32 + lo as f32;
-        disparity[x] = base + (best_d - lo) as f32 + offset;
-        range_low[x] = base + (scan.low - lo) as f32;
-        range_high[x] = base + (scan.high - lo) as f32;
+        // The decision, in integers; the floats follow for the whole row at once. The
+        // parabola runs through the best sum and its two neighbours when both are searchable
+        // (else three equal sums: no curvature, no offset).
+        let (c0, c2) = if best_d > lo && best_d + 1 < hi {
+            (before, after)
+        } else {
+            (scan.best_cost, scan.best_cost)
+        };
+        let disparity = dmin + best_d as isize;
+        found[x] = Found {
+            disparity: disparity as i32,
+            low: (dmin + scan.low as isize) as i32,
+            high: (dmin + scan.high as isize) as i32,
+            sums: [c0, scan.best_cost, c2].map(i32::from),
+        };
     };
     let (full_lo, full_hi) = full_columns(ctx);
     let full = sums[full_lo * stride..full_hi * stride].chunks_exact(stride);
@@ -471,6 +467,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         border[lo..hi].copy_from_slice(&sums[x * stride + lo..x * stride + hi]);
         decide(x, border, lo, hi);
     }
+    finish_row(found, out);
 }
 
 /// The window sums of one row (`sums`, `width × stride`) from the vertical sums, by a running
@@ -545,6 +542,54 @@ fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) {
         for k in 0..LANES {
             column[k] = previous[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
         }
+    }
+}
+
+/// A pixel's match in integers: absolute disparities (`min_disparity` included) of the winner
+/// and of the cost-curve range, and the window sums for the parabola.
+#[derive(Clone, Copy)]
+struct Found {
+    disparity: i32,
+    low: i32,
+    high: i32,
+    sums: [i32; 3],
+}
+
+impl Found {
+    /// No match.
+    const NONE: Self = Self {
+        disparity: i32::MIN,
+        low: 0,
+        high: 0,
+        sums: [0; 3],
+    };
+}
+
+/// The floats of one row from its integer matches: the parabola's sub-pixel offset (the
+/// vertex through the best sum and its neighbours, within half a pixel) and the three planes,
+/// `NaN` where no match. One pass over the row, which the compiler vectorises.
+fn finish_row(found: &[Found], out: [&mut [f32]; 3]) {
+    let [disparity, range_low, range_high] = out;
+    let planes = disparity
+        .iter_mut()
+        .zip(range_low.iter_mut())
+        .zip(range_high);
+    for (found, ((disparity, low), high)) in found.iter().zip(planes) {
+        let [c0, c1, c2] = found.sums.map(|c| c as f32);
+        let curvature = c0 - 2.0 * c1 + c2;
+        let offset = if curvature > 0.0 {
+            (0.5 * (c0 - c2) / curvature).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        let matched = found.disparity != i32::MIN;
+        *disparity = if matched {
+            found.disparity as f32 + offset
+        } else {
+            f32::NAN
+        };
+        *low = if matched { found.low as f32 } else { f32::NAN };
+        *high = if matched { found.high as f32 } else { f32::NAN };
     }
 }
 
