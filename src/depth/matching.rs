@@ -402,7 +402,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
     // `[lo, hi)` the searchable disparities.
     let mut decide = |x: usize, column: &[i16], lo: usize, hi: usize| {
         let scan = scan_column(column, &ctx.thresholds);
-        let best_d = scan.best;
+        let best_d = usize::from(scan.best);
         let xr = (x as isize - dmin - best_d as isize) as usize;
         if !right_valid.get(xr).copied().unwrap_or(false) {
             return;
@@ -430,7 +430,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         let (before, after) = (at(best_d.wrapping_sub(1)), at(best_d + 1));
         let near =
             1 + usize::from(before < scan.unique_bound) + usize::from(after < scan.unique_bound);
-        if scan.under_bound > near {
+        if usize::from(scan.under_bound) > near {
             return;
         }
         // The decision, in integers; the floats follow for the whole row at once. The

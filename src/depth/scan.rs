@@ -110,20 +110,21 @@ impl ScanLanes {
     }
 }
 
-/// What a scan of a pixel's column of window sums finds.
+/// What a scan of a pixel's column of window sums finds (small enough to come back in
+/// registers).
 pub(super) struct ColumnScan {
     /// The least sum.
     pub best_cost: i16,
     /// Its first index.
-    pub best: usize,
+    pub best: u16,
     /// First index within the range threshold.
-    pub low: usize,
+    pub low: u16,
     /// Last index within the range threshold.
-    pub high: usize,
+    pub high: u16,
     /// The uniqueness bound for this best cost.
     pub unique_bound: i16,
     /// How many sums lie strictly under the uniqueness bound.
-    pub under_bound: usize,
+    pub under_bound: u16,
 }
 
 /// Whether any of the sixteen lanes is at most `t`; compiles to one `pmovmskb` test.
@@ -149,9 +150,9 @@ fn any_at_most(c: &[i16; SCAN_LANES], t: i16) -> bool {
 #[inline(never)]
 pub(super) fn scan_column(column: &[i16], thresholds: &[(i16, i16)]) -> ColumnScan {
     let mut least = [i16::MAX; SCAN_LANES];
-    for chunk in column.chunks_exact(SCAN_LANES) {
-        for (l, &c) in least.iter_mut().zip(chunk) {
-            *l = (*l).min(c);
+    for chunk in column.as_chunks::<SCAN_LANES>().0 {
+        for k in 0..SCAN_LANES {
+            least[k] = least[k].min(chunk[k]);
         }
     }
     let best_cost = min_lane(least);
@@ -191,7 +192,7 @@ pub(super) fn scan_column(column: &[i16], thresholds: &[(i16, i16)]) -> ColumnSc
     // scalar chain).
     let (first_best, first_low) = (max_lane(acc.first_best), max_lane(acc.first_low));
     let (last_high, under) = (max_lane(acc.last_high), sum_lane(acc.under));
-    let first = |reverse: i16| MAX_DISPARITIES as usize - reverse as usize;
+    let first = |reverse: i16| (MAX_DISPARITIES as i16).wrapping_sub(reverse) as u16;
     let best = if first_best > 0 { first(first_best) } else { 0 };
     let low = if first_low > 0 {
         first(first_low)
@@ -202,9 +203,9 @@ pub(super) fn scan_column(column: &[i16], thresholds: &[(i16, i16)]) -> ColumnSc
         best_cost,
         best,
         low: low.min(best),
-        high: (last_high.max(0) as usize).max(best),
+        high: (last_high.max(0) as u16).max(best),
         unique_bound,
-        under_bound: under.max(0) as usize,
+        under_bound: under.max(0) as u16,
     }
 }
 
@@ -227,17 +228,17 @@ mod tests {
             let scan = scan_column(&column, &thresholds);
             assert_eq!(scan.best_cost, best_cost);
             let best = column.iter().position(|&c| c == best_cost).unwrap();
-            assert_eq!(scan.best, best);
+            assert_eq!(usize::from(scan.best), best);
             assert_eq!(
-                scan.low,
+                usize::from(scan.low),
                 column.iter().position(|&c| c <= best_cost + 5).unwrap()
             );
             assert_eq!(
-                scan.high,
+                usize::from(scan.high),
                 column.iter().rposition(|&c| c <= best_cost + 5).unwrap()
             );
             let under = column.iter().filter(|&&c| c < best_cost + 3).count();
-            assert_eq!(scan.under_bound, under);
+            assert_eq!(usize::from(scan.under_bound), under);
         }
     }
 }
