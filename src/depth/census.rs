@@ -37,37 +37,83 @@ pub struct CensusImage {
     pub valid: Vec<bool>,
 }
 
+/// The compared neighbours in bit order, as (window row, window column): neighbour `i` of 31
+/// lands at bit `30 - i` of the string.
+const NEIGHBOURS: [(usize, usize); CENSUS_BITS as usize] = {
+    let mut list = [(0, 0); CENSUS_BITS as usize];
+    let (mut i, mut r) = (0, 0);
+    while r < CENSUS_HEIGHT {
+        let mut k = 0;
+        while k < CENSUS_WIDTH {
+            if sampled(k, r) {
+                list[i] = (r, k);
+                i += 1;
+            }
+            k += 1;
+        }
+        r += 1;
+    }
+    list
+};
+
+/// Pixels per block of the interior loop: sixteen byte lanes.
+const BLOCK: usize = 16;
+
+/// Columns of a block's window.
+const SPAN: usize = BLOCK + CENSUS_WIDTH - 1;
+
+/// The neighbours of each byte of the string, highest byte first (7, 8, 8 and 8 of them).
+const PLANES: [std::ops::Range<usize>; 4] = [0..7, 7..15, 15..23, 23..31];
+
 /// Census strings of the interior columns `start..start + out.len()` of one row (no clamping
-/// needed there), built as four byte planes: each neighbour is one pass over the row whose
-/// comparisons fill sixteen byte lanes per instruction, then the planes are joined into `u32`
-/// strings. The bit order equals the clamped loop's: neighbour `i` of 31 at bit `30 - i`.
+/// needed there), sixteen pixels at a time: the block's centres and the four bytes of its
+/// strings stay in SIMD registers while the 31 neighbours are compared, each comparison
+/// filling one bit of sixteen byte lanes. The last block overlaps the one before when the row
+/// is not a whole number of blocks (recomputing a string is harmless). Rows narrower than a
+/// block use the clamped loop.
 fn interior_codes(
     rows: &[&[f32]; CENSUS_HEIGHT],
     centre: &[f32],
     out: &mut [CensusCode],
     start: usize,
-) {
-    let rx = CENSUS_WIDTH / 2;
+) -> bool {
     let n = out.len();
-    // Neighbours in bit order, as (row, column offset) in the window.
-    let neighbours = (0..CENSUS_HEIGHT).flat_map(|r| {
-        (0..CENSUS_WIDTH)
-            .filter(move |&k| sampled(k, r))
-            .map(move |k| (r, k))
-    });
-    let mut planes = [vec![0u8; n], vec![0u8; n], vec![0u8; n], vec![0u8; n]];
-    for (i, (r, k)) in neighbours.enumerate() {
-        // Neighbour i lands in byte (30 - i) / 8 of the string, counted from the lowest.
-        let plane = &mut planes[3 - (30 - i) / 8];
-        let row = &rows[r][start + k - rx..start + k - rx + n];
-        for ((code, &v), &c) in plane.iter_mut().zip(row).zip(centre) {
-            *code = (*code << 1) | u8::from(v < c);
+    if n < BLOCK {
+        return false;
+    }
+    let rx = CENSUS_WIDTH / 2;
+    for block in (0..n).step_by(BLOCK) {
+        let at = block.min(n - BLOCK);
+        let Ok(centres) = <&[f32; BLOCK]>::try_from(&centre[at..at + BLOCK]) else {
+            continue;
+        };
+        // The block's window, as fixed-size rows: the neighbour loads then need no checks.
+        let from = start + at - rx;
+        let window: [Option<&[f32; SPAN]>; CENSUS_HEIGHT] =
+            std::array::from_fn(|r| rows[r].get(from..from + SPAN)?.try_into().ok());
+        let mut bytes = [[0u8; BLOCK]; 4];
+        for (plane, neighbours) in bytes.iter_mut().zip(PLANES) {
+            for &(r, k) in &NEIGHBOURS[neighbours] {
+                let Some(Ok(values)) =
+                    window[r].map(|row| <&[f32; BLOCK]>::try_from(&row[k..k + BLOCK]))
+                else {
+                    continue;
+                };
+                // All-ones masks of the comparisons as `i32` (as wide as the `f32` lanes), then
+                // narrowed into the byte lanes: `plane = 2 plane + bit`.
+                let less: [i32; BLOCK] =
+                    std::array::from_fn(|j| -i32::from(values[j] < centres[j]));
+                for j in 0..BLOCK {
+                    plane[j] = (plane[j] << 1).wrapping_sub(less[j] as u8);
+                }
+            }
+        }
+        let [b0, b1, b2, b3] = &bytes;
+        for (j, code) in out[at..at + BLOCK].iter_mut().enumerate() {
+            *code = CensusCode::from_be_bytes([b0[j], b1[j], b2[j], b3[j]]);
         }
     }
-    let [p0, p1, p2, p3] = &planes;
-    for ((((code, &a), &b), &c), &d) in out.iter_mut().zip(p0).zip(p1).zip(p2).zip(p3) {
-        *code = CensusCode::from_be_bytes([a, b, c, d]);
-    }
+    true
 }
 
 /// Computes the 9 × 7 census transform. Neighbours beyond the border repeat the border pixel
@@ -93,24 +139,24 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
                 &pixels[yy * width..(yy + 1) * width]
             });
             let centre_row = rows[ry];
-            // Interior pixels, whose window needs no clamping: one pass per neighbour over the
-            // whole row, which the compiler vectorises.
+            // Interior pixels, whose window needs no clamping, in vectorised blocks; the clamped
+            // loop below takes the rest (all of a row narrower than the window or a block).
             let interior = if width > 2 * rx {
                 rx..width - rx
             } else {
                 rx..rx
             };
-            // (Images narrower than the window have no interior: `rx..rx` is empty and only the
-            // clamped loop below runs; the slices are then never taken.)
-            let interior_ok = !interior.is_empty();
-            let centre = if interior_ok {
-                &centre_row[interior.clone()]
+            let interior = if !interior.is_empty()
+                && interior_codes(
+                    &rows,
+                    &centre_row[interior.clone()],
+                    &mut out[interior.clone()],
+                    interior.start,
+                ) {
+                interior
             } else {
-                &[][..]
+                rx..rx
             };
-            if interior_ok {
-                interior_codes(&rows, centre, &mut out[interior.clone()], interior.start);
-            }
             // Border columns, clamped.
             for x in (0..width).filter(|x| !interior.contains(x)) {
                 let centre = centre_row[x];
@@ -129,5 +175,50 @@ pub fn census_transform(image: &GrayImage) -> CensusImage {
         height,
         codes,
         valid,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The census by its definition, one pixel at a time with clamped neighbours.
+    fn plain(image: &GrayImage) -> Vec<CensusCode> {
+        let (w, h) = (image.width() as usize, image.height() as usize);
+        let p = image.pixels();
+        let mut codes = vec![0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let centre = p[y * w + x];
+                let mut bits: CensusCode = 0;
+                for &(r, k) in &NEIGHBOURS {
+                    let yy = (y + r).saturating_sub(CENSUS_HEIGHT / 2).min(h - 1);
+                    let xx = (x + k).saturating_sub(CENSUS_WIDTH / 2).min(w - 1);
+                    bits = (bits << 1) | CensusCode::from(p[yy * w + xx] < centre);
+                }
+                codes[y * w + x] = bits;
+            }
+        }
+        codes
+    }
+
+    #[test]
+    fn blocks_match_the_definition() {
+        // Widths around the window and the block (interior 0, 15, 16, 17, 33 and more), with
+        // fractions, ties and missing values.
+        for width in [1usize, 8, 9, 23, 24, 25, 41, 60] {
+            let height = 9;
+            let pixels: Vec<f32> = (0..width * height)
+                .map(|i| match i % 37 {
+                    5 => f32::NAN,
+                    _ => ((i * 7919 + 13) % 50) as f32 * 0.5,
+                })
+                .collect();
+            let image = GrayImage::new(width as u32, height as u32, pixels).unwrap();
+            let census = census_transform(&image);
+            assert_eq!(census.codes, plain(&image), "width {width}");
+            assert!(!census.valid[5]);
+            assert!(census.codes.iter().all(|&c| c < 1 << CENSUS_BITS));
+        }
     }
 }
