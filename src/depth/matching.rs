@@ -338,7 +338,9 @@ fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize) {
                 .zip(q1.chunks_exact(LANES))
                 .zip(q2.chunks_exact(LANES))
                 .zip(q3.chunks_exact(LANES));
-            for ((((costs, q0), q1), q2), q3) in steps {
+            // Only the chunks with a searchable disparity; the others are filled below.
+            let chunks = (lo / LANES)..hi.div_ceil(LANES);
+            for ((((costs, q0), q1), q2), q3) in steps.skip(chunks.start).take(chunks.len()) {
                 costs.copy_from_slice(&chunk_costs(code.to_le_bytes(), [q0, q1, q2, q3]));
             }
         }
@@ -499,8 +501,28 @@ fn horizontal_row(
     }
     // Padding lanes: the vertical sums there are 0, so they stay at `i16::MAX`.
     first[nd..].fill(i16::MAX);
+    // Column x adds the vertical sums of column x + rx and takes out those of x - rx - 1, both
+    // clamped to the image; in the middle of the row neither needs clamping, and they come
+    // from two iterators instead.
+    let clamped = |x: usize| !(rx + 1..w.saturating_sub(rx)).contains(&x);
     let mut previous: &[i16] = first;
-    for (x, column) in (1..).zip(rest.chunks_exact_mut(stride)) {
+    let mut columns = (1..).zip(rest.chunks_exact_mut(stride)).peekable();
+    while let Some((x, column)) = columns.next_if(|(x, _)| clamped(*x)) {
+        let add = vertical_at(x as isize + rx as isize);
+        let sub = vertical_at(x as isize - rx as isize - 1);
+        slide(column, previous, add, sub);
+        previous = column;
+    }
+    let middle = vertical
+        .chunks_exact(stride)
+        .skip(2 * rx + 1)
+        .zip(vertical.chunks_exact(stride));
+    let unclamped = w.saturating_sub(rx).saturating_sub(rx + 1);
+    for ((_, column), (add, sub)) in columns.by_ref().take(unclamped).zip(middle) {
+        slide(column, previous, add, sub);
+        previous = column;
+    }
+    for (x, column) in columns {
         let add = vertical_at(x as isize + rx as isize);
         let sub = vertical_at(x as isize - rx as isize - 1);
         slide(column, previous, add, sub);
