@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
 use super::gray::GrayImage;
 use super::params::{DisparityMap, MatchParams};
-use super::scan::scan_column;
+use super::scan::{min_lane, scan_column};
 use crate::error::{Error, Result};
 
 /// Disparities per step of the cost loop: sixteen `u8` lanes, one SSE register.
@@ -166,6 +166,8 @@ struct Band {
     border: Vec<i16>,
     /// The current row's matches.
     found: Vec<Found>,
+    /// The current row's least window sum per pixel.
+    least: Vec<i16>,
 }
 
 /// Matches rows `y0..y1` into `out`: the band's rows of the disparity, range-low and range-high
@@ -182,6 +184,7 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 3]) {
         column: vec![0; stride],
         border: vec![0; stride],
         found: vec![Found::NONE; w],
+        least: vec![0; w],
     };
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds row first + k (clamped). The
     // ring starts at zero, so entering a row only adds it.
@@ -388,9 +391,10 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         right_cost,
         border,
         found,
+        least,
         ..
     } = band;
-    horizontal_row(vertical, sums, right_cost, w, nd, ctx.radius_x);
+    horizontal_row(vertical, sums, right_cost, least, w, nd, ctx.radius_x);
     let reach = ctx
         .params
         .left_right_tolerance
@@ -402,8 +406,8 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
     // lanes and, at the border columns, disparities whose right pixel lies outside the image
     // at `i16::MAX`, which never wins, never lies in the range and is never a rival;
     // `[lo, hi)` the searchable disparities.
-    let mut decide = |x: usize, column: &[i16], lo: usize, hi: usize| {
-        let scan = scan_column(column, &ctx.thresholds);
+    let mut decide = |x: usize, column: &[i16], best_cost: i16, lo: usize, hi: usize| {
+        let scan = scan_column(column, best_cost, &ctx.thresholds);
         let best_d = usize::from(scan.best);
         let xr = (x as isize - dmin - best_d as isize) as usize;
         if !right_valid.get(xr).copied().unwrap_or(false) {
@@ -458,7 +462,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         .zip(&left_valid[full_lo..full_hi])
         .filter(|(_, v)| **v)
     {
-        decide(x, column, 0, nd);
+        decide(x, column, least[x], 0, nd);
     }
     for x in (0..full_lo).chain(full_hi..w) {
         let (lo, hi) = valid_range(ctx, x);
@@ -467,7 +471,8 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         }
         border.fill(i16::MAX);
         border[lo..hi].copy_from_slice(&sums[x * stride + lo..x * stride + hi]);
-        decide(x, border, lo, hi);
+        let best_cost = border[lo..hi].iter().copied().fold(i16::MAX, i16::min);
+        decide(x, border, best_cost, lo, hi);
     }
     finish_row(found, out);
 }
@@ -482,6 +487,7 @@ fn horizontal_row(
     vertical: &[i16],
     sums: &mut [i16],
     right_cost: &mut [i16],
+    least: &mut [i16],
     w: usize,
     nd: usize,
     rx: usize,
@@ -505,12 +511,13 @@ fn horizontal_row(
     // clamped to the image; in the middle of the row neither needs clamping, and they come
     // from two iterators instead.
     let clamped = |x: usize| !(rx + 1..w.saturating_sub(rx)).contains(&x);
+    least[0] = first.iter().copied().fold(i16::MAX, i16::min);
     let mut previous: &[i16] = first;
     let mut columns = (1..).zip(rest.chunks_exact_mut(stride)).peekable();
     while let Some((x, column)) = columns.next_if(|(x, _)| clamped(*x)) {
         let add = vertical_at(x as isize + rx as isize);
         let sub = vertical_at(x as isize - rx as isize - 1);
-        slide(column, previous, add, sub);
+        least[x] = slide(column, previous, add, sub);
         previous = column;
     }
     let middle = vertical
@@ -518,14 +525,14 @@ fn horizontal_row(
         .skip(2 * rx + 1)
         .zip(vertical.chunks_exact(stride));
     let unclamped = w.saturating_sub(rx).saturating_sub(rx + 1);
-    for ((_, column), (add, sub)) in columns.by_ref().take(unclamped).zip(middle) {
-        slide(column, previous, add, sub);
+    for ((x, column), (add, sub)) in columns.by_ref().take(unclamped).zip(middle) {
+        least[x] = slide(column, previous, add, sub);
         previous = column;
     }
     for (x, column) in columns {
         let add = vertical_at(x as isize + rx as isize);
         let sub = vertical_at(x as isize - rx as isize - 1);
-        slide(column, previous, add, sub);
+        least[x] = slide(column, previous, add, sub);
         previous = column;
     }
     // The right image's least sums, column by column into the mirrored array, whose window
@@ -546,7 +553,8 @@ fn horizontal_row(
 /// (Not inlined: inlined, the compiler loses track of `column` and `previous` being apart
 /// and compiles it one lane at a time.)
 #[inline(never)]
-fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) {
+fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) -> i16 {
+    let mut least = [i16::MAX; LANES];
     let steps = column
         .chunks_exact_mut(LANES)
         .zip(previous.chunks_exact(LANES))
@@ -563,8 +571,10 @@ fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) {
         };
         for k in 0..LANES {
             column[k] = previous[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
+            least[k] = least[k].min(column[k]);
         }
     }
+    min_lane(least)
 }
 
 /// A pixel's match in integers: absolute disparities (`min_disparity` included) of the winner
