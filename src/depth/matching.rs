@@ -254,7 +254,7 @@ fn plane_slices(planes: &[Vec<u8>; CODE_BYTES], start: usize, len: usize) -> [&[
 /// Costs one column whose disparities are all searchable and enters it: `vertical += cost -
 /// old`, then `old = cost` (padding lanes cost 0 through `keep`). The costs stay in registers.
 #[inline(always)]
-fn enter_full_column(
+fn enter_full_column<const PADDED: bool>(
     code: [u8; CODE_BYTES],
     q: [&[u8]; CODE_BYTES],
     keep: &[u8],
@@ -281,8 +281,10 @@ fn enter_full_column(
             continue;
         };
         let mut costs = chunk_costs(code, [q0, q1, q2, q3]);
-        for k in 0..LANES {
-            costs[k] &= keep[k];
+        if PADDED {
+            for k in 0..LANES {
+                costs[k] &= keep[k];
+            }
         }
         let change: [i16; LANES] = std::array::from_fn(|k| i16::from(costs[k]) - i16::from(old[k]));
         for k in 0..LANES {
@@ -370,13 +372,19 @@ fn enter_full_columns(
     vertical: &mut [i16],
 ) {
     let stride = keep.len();
+    // Padding lanes exist when the disparities are not a whole number of chunks.
+    let padded = keep.contains(&0);
     let columns = old
         .chunks_exact_mut(stride)
         .zip(vertical.chunks_exact_mut(stride));
     for (i, (&code, (old, vertical))) in codes.iter().zip(columns).enumerate() {
         let at = start - i;
         let q = planes.map(|plane| &plane[at..at + stride]);
-        enter_full_column(code.to_le_bytes(), q, keep, old, vertical);
+        if padded {
+            enter_full_column::<true>(code.to_le_bytes(), q, keep, old, vertical);
+        } else {
+            enter_full_column::<false>(code.to_le_bytes(), q, keep, old, vertical);
+        }
     }
 }
 
