@@ -8,11 +8,12 @@
 //! contiguous disparities that the compiler vectorises. The image is split into bands of rows,
 //! one per thread. A band keeps the `u8` costs of the window's rows in a ring and their
 //! column sums (vertical sums); a row entering the window is costed and added in the same loop
-//! that takes out the row leaving it. Each output row then runs once along its columns: the
-//! horizontal running sum, the right image's least costs for the left-right check, and the
-//! per-pixel decision, while the pixel's column of sums is still in the L1 cache. The cost volume
-//! is never stored whole. All arithmetic is on integers, so the result is the same for any
-//! number of threads and any band split.
+//! that takes out the row leaving it. Each output row then takes a running sum along its columns
+//! (which also yields each pixel's least sum), folds the right image's least sums for the
+//! left-right check, and decides pixel by pixel (`scan.rs` scans a pixel's sums); the floats of
+//! the row come last, in one vectorised pass. The cost volume is never stored whole. All
+//! arithmetic up to the sub-pixel step is on integers, so the result is the same for any number
+//! of threads and any band split.
 
 use rayon::prelude::*;
 

@@ -1,7 +1,7 @@
-//! Vectorised reductions over one pixel's column of window sums (the disparity axis): the best
-//! cost, its first index, the cost-curve range and the count under the uniqueness bound. Written as fixed-size
-//! lane accumulators with branch-free selects, because `Iterator::min` and early-exit searches
-//! compile to one element at a time.
+//! Vectorised reductions over one pixel's column of window sums (the disparity axis): the first
+//! index of the least sum, the cost-curve range and the count under the uniqueness bound.
+//! Written as fixed-size lane accumulators with branch-free selects, because `Iterator::min`
+//! and early-exit searches compile to one element at a time.
 
 use super::params::MAX_DISPARITIES;
 
