@@ -1,5 +1,6 @@
 //! Matching speed on the Middlebury motorcycle pair at its full 741×500 with 80 disparities
-//! (census, costs, aggregation, checks and sub-pixel step; the images are loaded once).
+//! (census, costs, aggregation, checks and sub-pixel step; the images are loaded once), and the
+//! census transform of the pair on its own.
 //!
 //! Needs `FUZZYVOX_DATA`; without it the benchmark says so and skips.
 //! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench stereo` (set `RAYON_NUM_THREADS=2`
@@ -8,7 +9,9 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use fuzzyvox::depth::{DepthParams, MatchParams, depth_from_rectified, match_pair};
+use fuzzyvox::depth::{
+    DepthParams, MatchParams, census_transform, depth_from_rectified, match_pair,
+};
 use fuzzyvox::io::middlebury::read_middlebury;
 
 fn data_dir() -> Option<PathBuf> {
@@ -29,6 +32,9 @@ fn stereo(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("stereo_motorcycle_741x500_80d");
     group.sample_size(20);
+    group.bench_function("census_pair", |b| {
+        b.iter(|| (census_transform(&pair.left), census_transform(&pair.right)))
+    });
     group.bench_function("match", |b| {
         b.iter(|| match_pair(&pair.left, &pair.right, &matching).expect("matching"))
     });

@@ -8,18 +8,19 @@
 //! contiguous disparities that the compiler vectorises. The image is split into bands of rows,
 //! one per thread. A band keeps the `u8` costs of the window's rows in a ring and their
 //! column sums (vertical sums); a row entering the window is costed and added in the same loop
-//! that takes out the row leaving it. Each output row then runs once along its columns: the
-//! horizontal running sum, the right image's least costs for the left-right check, and the
-//! per-pixel decision, while the pixel's column of sums is still in the L1 cache. The cost volume
-//! is never stored whole. All arithmetic is on integers, so the result is the same for any
-//! number of threads and any band split.
+//! that takes out the row leaving it. Each output row then takes a running sum along its columns
+//! (which also yields each pixel's least sum), folds the right image's least sums for the
+//! left-right check, and decides pixel by pixel (`scan.rs` scans a pixel's sums); the floats of
+//! the row come last, in one vectorised pass. The cost volume is never stored whole. All
+//! arithmetic up to the sub-pixel step is on integers, so the result is the same for any number
+//! of threads and any band split.
 
 use rayon::prelude::*;
 
 use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
 use super::gray::GrayImage;
 use super::params::{DisparityMap, MatchParams};
-use super::scan::scan_column;
+use super::scan::{min_lane, scan_column};
 use crate::error::{Error, Result};
 
 /// Disparities per step of the cost loop: sixteen `u8` lanes, one SSE register.
@@ -166,6 +167,8 @@ struct Band {
     border: Vec<i16>,
     /// The current row's matches.
     found: Vec<Found>,
+    /// The current row's least window sum per pixel.
+    least: Vec<i16>,
 }
 
 /// Matches rows `y0..y1` into `out`: the band's rows of the disparity, range-low and range-high
@@ -182,6 +185,7 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 3]) {
         column: vec![0; stride],
         border: vec![0; stride],
         found: vec![Found::NONE; w],
+        least: vec![0; w],
     };
     // Prime the window of rows y0 - ry ..= y0 + ry; slot k holds row first + k (clamped). The
     // ring starts at zero, so entering a row only adds it.
@@ -251,7 +255,7 @@ fn plane_slices(planes: &[Vec<u8>; CODE_BYTES], start: usize, len: usize) -> [&[
 /// Costs one column whose disparities are all searchable and enters it: `vertical += cost -
 /// old`, then `old = cost` (padding lanes cost 0 through `keep`). The costs stay in registers.
 #[inline(always)]
-fn enter_full_column(
+fn enter_full_column<const PADDED: bool>(
     code: [u8; CODE_BYTES],
     q: [&[u8]; CODE_BYTES],
     keep: &[u8],
@@ -278,8 +282,10 @@ fn enter_full_column(
             continue;
         };
         let mut costs = chunk_costs(code, [q0, q1, q2, q3]);
-        for k in 0..LANES {
-            costs[k] &= keep[k];
+        if PADDED {
+            for k in 0..LANES {
+                costs[k] &= keep[k];
+            }
         }
         let change: [i16; LANES] = std::array::from_fn(|k| i16::from(costs[k]) - i16::from(old[k]));
         for k in 0..LANES {
@@ -338,7 +344,9 @@ fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize) {
                 .zip(q1.chunks_exact(LANES))
                 .zip(q2.chunks_exact(LANES))
                 .zip(q3.chunks_exact(LANES));
-            for ((((costs, q0), q1), q2), q3) in steps {
+            // Only the chunks with a searchable disparity; the others are filled below.
+            let chunks = (lo / LANES)..hi.div_ceil(LANES);
+            for ((((costs, q0), q1), q2), q3) in steps.skip(chunks.start).take(chunks.len()) {
                 costs.copy_from_slice(&chunk_costs(code.to_le_bytes(), [q0, q1, q2, q3]));
             }
         }
@@ -365,13 +373,19 @@ fn enter_full_columns(
     vertical: &mut [i16],
 ) {
     let stride = keep.len();
+    // Padding lanes exist when the disparities are not a whole number of chunks.
+    let padded = keep.contains(&0);
     let columns = old
         .chunks_exact_mut(stride)
         .zip(vertical.chunks_exact_mut(stride));
     for (i, (&code, (old, vertical))) in codes.iter().zip(columns).enumerate() {
         let at = start - i;
         let q = planes.map(|plane| &plane[at..at + stride]);
-        enter_full_column(code.to_le_bytes(), q, keep, old, vertical);
+        if padded {
+            enter_full_column::<true>(code.to_le_bytes(), q, keep, old, vertical);
+        } else {
+            enter_full_column::<false>(code.to_le_bytes(), q, keep, old, vertical);
+        }
     }
 }
 
@@ -386,9 +400,10 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         right_cost,
         border,
         found,
+        least,
         ..
     } = band;
-    horizontal_row(vertical, sums, right_cost, w, nd, ctx.radius_x);
+    horizontal_row(vertical, sums, right_cost, least, w, nd, ctx.radius_x);
     let reach = ctx
         .params
         .left_right_tolerance
@@ -400,8 +415,8 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
     // lanes and, at the border columns, disparities whose right pixel lies outside the image
     // at `i16::MAX`, which never wins, never lies in the range and is never a rival;
     // `[lo, hi)` the searchable disparities.
-    let mut decide = |x: usize, column: &[i16], lo: usize, hi: usize| {
-        let scan = scan_column(column, &ctx.thresholds);
+    let mut decide = |x: usize, column: &[i16], best_cost: i16, lo: usize, hi: usize| {
+        let scan = scan_column(column, best_cost, &ctx.thresholds);
         let best_d = usize::from(scan.best);
         let xr = (x as isize - dmin - best_d as isize) as usize;
         if !right_valid.get(xr).copied().unwrap_or(false) {
@@ -456,7 +471,7 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         .zip(&left_valid[full_lo..full_hi])
         .filter(|(_, v)| **v)
     {
-        decide(x, column, 0, nd);
+        decide(x, column, least[x], 0, nd);
     }
     for x in (0..full_lo).chain(full_hi..w) {
         let (lo, hi) = valid_range(ctx, x);
@@ -465,7 +480,8 @@ fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
         }
         border.fill(i16::MAX);
         border[lo..hi].copy_from_slice(&sums[x * stride + lo..x * stride + hi]);
-        decide(x, border, lo, hi);
+        let best_cost = border[lo..hi].iter().copied().fold(i16::MAX, i16::min);
+        decide(x, border, best_cost, lo, hi);
     }
     finish_row(found, out);
 }
@@ -480,6 +496,7 @@ fn horizontal_row(
     vertical: &[i16],
     sums: &mut [i16],
     right_cost: &mut [i16],
+    least: &mut [i16],
     w: usize,
     nd: usize,
     rx: usize,
@@ -499,11 +516,32 @@ fn horizontal_row(
     }
     // Padding lanes: the vertical sums there are 0, so they stay at `i16::MAX`.
     first[nd..].fill(i16::MAX);
+    // Column x adds the vertical sums of column x + rx and takes out those of x - rx - 1, both
+    // clamped to the image; in the middle of the row neither needs clamping, and they come
+    // from two iterators instead.
+    let clamped = |x: usize| !(rx + 1..w.saturating_sub(rx)).contains(&x);
+    least[0] = first.iter().copied().fold(i16::MAX, i16::min);
     let mut previous: &[i16] = first;
-    for (x, column) in (1..).zip(rest.chunks_exact_mut(stride)) {
+    let mut columns = (1..).zip(rest.chunks_exact_mut(stride)).peekable();
+    while let Some((x, column)) = columns.next_if(|(x, _)| clamped(*x)) {
         let add = vertical_at(x as isize + rx as isize);
         let sub = vertical_at(x as isize - rx as isize - 1);
-        slide(column, previous, add, sub);
+        least[x] = slide(column, previous, add, sub);
+        previous = column;
+    }
+    let middle = vertical
+        .chunks_exact(stride)
+        .skip(2 * rx + 1)
+        .zip(vertical.chunks_exact(stride));
+    let unclamped = w.saturating_sub(rx).saturating_sub(rx + 1);
+    for ((x, column), (add, sub)) in columns.by_ref().take(unclamped).zip(middle) {
+        least[x] = slide(column, previous, add, sub);
+        previous = column;
+    }
+    for (x, column) in columns {
+        let add = vertical_at(x as isize + rx as isize);
+        let sub = vertical_at(x as isize - rx as isize - 1);
+        least[x] = slide(column, previous, add, sub);
         previous = column;
     }
     // The right image's least sums, column by column into the mirrored array, whose window
@@ -524,7 +562,8 @@ fn horizontal_row(
 /// (Not inlined: inlined, the compiler loses track of `column` and `previous` being apart
 /// and compiles it one lane at a time.)
 #[inline(never)]
-fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) {
+fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) -> i16 {
+    let mut least = [i16::MAX; LANES];
     let steps = column
         .chunks_exact_mut(LANES)
         .zip(previous.chunks_exact(LANES))
@@ -541,8 +580,10 @@ fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) {
         };
         for k in 0..LANES {
             column[k] = previous[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
+            least[k] = least[k].min(column[k]);
         }
     }
+    min_lane(least)
 }
 
 /// A pixel's match in integers: absolute disparities (`min_disparity` included) of the winner

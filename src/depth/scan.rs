@@ -1,7 +1,7 @@
-//! Vectorised reductions over one pixel's column of window sums (the disparity axis): the best
-//! cost, its first index, the cost-curve range and the count under the uniqueness bound. Written as fixed-size
-//! lane accumulators with branch-free selects, because `Iterator::min` and early-exit searches
-//! compile to one element at a time.
+//! Vectorised reductions over one pixel's column of window sums (the disparity axis): the first
+//! index of the least sum, the cost-curve range and the count under the uniqueness bound.
+//! Written as fixed-size lane accumulators with branch-free selects, because `Iterator::min`
+//! and early-exit searches compile to one element at a time.
 
 use super::params::MAX_DISPARITIES;
 
@@ -65,7 +65,7 @@ fn sum_lane(mut a: [i16; SCAN_LANES]) -> i16 {
 
 /// The smallest lane, by halving (`N` a power of two).
 #[inline(always)]
-fn min_lane<const N: usize>(mut a: [i16; N]) -> i16 {
+pub(super) fn min_lane<const N: usize>(mut a: [i16; N]) -> i16 {
     let mut half = N / 2;
     while half > 0 {
         for k in 0..half {
@@ -148,14 +148,7 @@ fn any_at_most(c: &[i16; SCAN_LANES], t: i16) -> bool {
 /// vector test. The chunks that count go through branch-free lane accumulators (all-ones
 /// masks). Not inlined: the compiler vectorises it reliably only on its own.
 #[inline(never)]
-pub(super) fn scan_column(column: &[i16], thresholds: &[(i16, i16)]) -> ColumnScan {
-    let mut least = [i16::MAX; SCAN_LANES];
-    for chunk in column.as_chunks::<SCAN_LANES>().0 {
-        for k in 0..SCAN_LANES {
-            least[k] = least[k].min(chunk[k]);
-        }
-    }
-    let best_cost = min_lane(least);
+pub(super) fn scan_column(column: &[i16], best_cost: i16, thresholds: &[(i16, i16)]) -> ColumnScan {
     let (range_threshold, unique_bound) = thresholds
         .get(best_cost.max(0) as usize)
         .copied()
@@ -225,7 +218,7 @@ mod tests {
             let best_cost = *column.iter().min().unwrap();
             // Range threshold best + 5, uniqueness bound best + 3.
             let thresholds: Vec<(i16, i16)> = (0..100).map(|b| (b + 5, b + 3)).collect();
-            let scan = scan_column(&column, &thresholds);
+            let scan = scan_column(&column, best_cost, &thresholds);
             assert_eq!(scan.best_cost, best_cost);
             let best = column.iter().position(|&c| c == best_cost).unwrap();
             assert_eq!(usize::from(scan.best), best);
