@@ -9,7 +9,8 @@ mod common;
 use arbitrary::Arbitrary;
 use common::{Metres, Pose};
 use fuzzyvox::depth::{
-    DepthParams, Frame, GrayImage, IntervalMethod, IntervalParams, MatchParams, depth_from_pair,
+    DepthParams, ForwardMotion, Frame, GrayImage, IntervalMethod, IntervalParams, MatchParams,
+    depth_from_pair,
 };
 use fuzzyvox::{Error, PinholeIntrinsics};
 use libfuzzer_sys::fuzz_target;
@@ -33,6 +34,8 @@ struct Input {
     left_right_tolerance: Option<u8>,
     range_tolerance: f32,
     fixed_delta: bool,
+    /// Match forward-motion pairs by plane sweep instead of refusing them.
+    plane_sweep: bool,
     delta: f32,
     confidence_slope: f64,
     depth_range: Option<(Metres, Metres)>,
@@ -97,6 +100,11 @@ fuzz_target!(|input: Input| {
             confidence_slope: input.confidence_slope,
         },
         depth_range: input.depth_range.map(|(a, b)| (a.value(), b.value())),
+        forward_motion: if input.plane_sweep {
+            ForwardMotion::PlaneSweep
+        } else {
+            ForwardMotion::Reject
+        },
     };
     match depth_from_pair(&reference, &other, &params) {
         Ok(result) => {
