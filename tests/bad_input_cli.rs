@@ -3,15 +3,11 @@
 //! and leaves any existing output file as it was. Cases already in `cli.rs` are not repeated;
 //! the table of every case is in `docs/robustness.md`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn fuzzyvox(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
-        .args(args)
-        .output()
-        .expect("running fuzzyvox")
-}
+use common::fuzzyvox;
+
+use std::path::{Path, PathBuf};
 
 /// Runs a command that must fail with `status`, whose standard error must contain `expected`.
 #[track_caller]

@@ -2,25 +2,7 @@
 
 mod common;
 
-use std::process::Command;
-
-use common::data_dir;
-
-fn fuzzyvox(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
-        .args(args)
-        .output()
-        .expect("running fuzzyvox")
-}
-
-fn json(output: &std::process::Output) -> serde_json::Value {
-    assert!(
-        output.status.success(),
-        "fuzzyvox failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
-}
+use common::{data_dir, fuzzyvox, json};
 
 #[test]
 fn insert_logodds_reports_octomap_counts() {

@@ -1,23 +1,10 @@
 //! The experiment commands (`eval`, `simulate`, `demo`), run as a user would.
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::Command;
 
-fn fuzzyvox(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
-        .args(args)
-        .output()
-        .expect("running fuzzyvox")
-}
-
-fn json(output: &std::process::Output) -> serde_json::Value {
-    assert!(
-        output.status.success(),
-        "fuzzyvox failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
-}
+use common::{fuzzyvox, json};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-{name}-{}", std::process::id()));

@@ -3,25 +3,8 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use common::data_dir;
-
-fn fuzzyvox(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
-        .args(args)
-        .output()
-        .expect("running fuzzyvox")
-}
-
-fn json(output: &Output) -> serde_json::Value {
-    assert!(
-        output.status.success(),
-        "fuzzyvox failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
-}
+use common::{data_dir, fuzzyvox, json};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("fuzzyvox-rgbd-{}-{name}", std::process::id()));

@@ -4,25 +4,8 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use common::Rng;
-
-fn fuzzyvox(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
-        .args(args)
-        .output()
-        .expect("running fuzzyvox")
-}
-
-fn json(output: &Output) -> serde_json::Value {
-    assert!(
-        output.status.success(),
-        "fuzzyvox failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
-}
+use common::{Rng, fuzzyvox, json};
 
 /// Runs a command that must fail with `code` and a message containing `expected`.
 fn fails(args: &[&str], code: i32, expected: &str) {
