@@ -26,4 +26,6 @@ pub use frustum::depth_evidence;
 pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;
 pub use raywalk::{walk_ray, walk_ray_until};
-pub use scan_sets::{BlockFlags, ScanSets, scan_sets};
+pub use scan_sets::{
+    BlockFlags, BlockLevels, CellMarks, ScanBlocks, ScanLevels, ScanSets, scan_levels, scan_sets,
+};

@@ -26,69 +26,192 @@ impl BlockFlags {
     }
 }
 
+/// What a scan records about the cells of one block as rays are walked: whether (or, with
+/// levels, up to which level) a ray passed through a cell and an end point lies in it.
+pub trait CellMarks: Copy + Default + Send {
+    /// A ray of `level` passed through cell `i`.
+    fn pass(&mut self, i: usize, level: u16);
+    /// An end point of `level` lies in cell `i`.
+    fn hit(&mut self, i: usize, level: u16);
+    /// Takes in another partial record of the same block (exact: the split does not matter).
+    fn unite(&mut self, other: &Self);
+}
+
+impl CellMarks for BlockFlags {
+    #[inline]
+    fn pass(&mut self, i: usize, _level: u16) {
+        self.passed[i / 64] |= 1 << (i % 64);
+    }
+
+    #[inline]
+    fn hit(&mut self, i: usize, _level: u16) {
+        self.hit[i / 64] |= 1 << (i % 64);
+    }
+
+    fn unite(&mut self, other: &Self) {
+        for w in 0..BLOCK_CELLS / 64 {
+            self.passed[w] |= other.passed[w];
+            self.hit[w] |= other.hit[w];
+        }
+    }
+}
+
+/// One block of a scan whose points carry levels (the alpha-cut map's nested confidence
+/// cuts): per cell, the highest level of a ray that passed through it and of an end point in
+/// it (0: none).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlockLevels {
+    /// Highest level of a ray that passed through each cell.
+    pub passed: [u16; BLOCK_CELLS],
+    /// Highest level of an end point in each cell.
+    pub hit: [u16; BLOCK_CELLS],
+}
+
+impl Default for BlockLevels {
+    fn default() -> Self {
+        Self {
+            passed: [0; BLOCK_CELLS],
+            hit: [0; BLOCK_CELLS],
+        }
+    }
+}
+
+impl CellMarks for BlockLevels {
+    #[inline]
+    fn pass(&mut self, i: usize, level: u16) {
+        if let Some(cell) = self.passed.get_mut(i) {
+            *cell = (*cell).max(level);
+        }
+    }
+
+    #[inline]
+    fn hit(&mut self, i: usize, level: u16) {
+        if let Some(cell) = self.hit.get_mut(i) {
+            *cell = (*cell).max(level);
+        }
+    }
+
+    fn unite(&mut self, other: &Self) {
+        for (a, b) in self.passed.iter_mut().zip(&other.passed) {
+            *a = (*a).max(*b);
+        }
+        for (a, b) in self.hit.iter_mut().zip(&other.hit) {
+            *a = (*a).max(*b);
+        }
+    }
+}
+
+/// One scan's record, block by block, for the blocks that rays reached.
+#[derive(Clone, Debug, Default)]
+pub struct ScanBlocks<B> {
+    index: FxHashMap<BlockKey, usize>,
+    keys: Vec<BlockKey>,
+    blocks: Vec<B>,
+}
+
 /// One scan in the standard method's terms: per voxel, whether a ray passed through it and
 /// whether an end point lies in it (a voxel with both counts as hit). Two bits per voxel keep
 /// a whole scan's sets small enough to stay in cache while rays are walked.
-#[derive(Clone, Debug, Default)]
-pub struct ScanSets {
-    index: FxHashMap<BlockKey, usize>,
-    keys: Vec<BlockKey>,
-    blocks: Vec<BlockFlags>,
-}
+pub type ScanSets = ScanBlocks<BlockFlags>;
 
-impl ScanSets {
+/// A scan whose points carry levels: per voxel, the highest level of a ray through it and of
+/// an end point in it. [`ScanLevels::cut`] gives the sets of the points of one level and up.
+pub type ScanLevels = ScanBlocks<BlockLevels>;
+
+impl<B: CellMarks> ScanBlocks<B> {
     /// No voxel marked.
     pub fn new() -> Self {
-        Self::default()
+        Self {
+            index: FxHashMap::default(),
+            keys: Vec::new(),
+            blocks: Vec::new(),
+        }
     }
 
     /// Blocks with any voxel marked, with their keys.
-    pub fn blocks(&self) -> impl ExactSizeIterator<Item = (BlockKey, &BlockFlags)> {
+    pub fn blocks(&self) -> impl ExactSizeIterator<Item = (BlockKey, &B)> {
         self.keys.iter().copied().zip(self.blocks.iter())
-    }
-
-    /// Whether a ray passed through `key`, and whether it holds an end point.
-    pub fn flags(&self, key: VoxelKey) -> (bool, bool) {
-        self.index
-            .get(&key.block())
-            .map_or((false, false), |&i| self.blocks[i].get(key.cell_index()))
     }
 
     #[inline]
     fn position(&mut self, key: BlockKey) -> usize {
         *self.index.entry(key).or_insert_with(|| {
             self.keys.push(key);
-            self.blocks.push(BlockFlags::default());
+            self.blocks.push(B::default());
             self.blocks.len() - 1
         })
     }
 
-    /// Unites two partial scans (bitwise or: exact, so the split does not matter).
-    fn union(mut self, other: ScanSets) -> ScanSets {
+    /// Unites two partial scans (exact, so the split does not matter).
+    fn union(mut self, other: Self) -> Self {
         if self.blocks.len() < other.blocks.len() {
             return other.union(self);
         }
-        for (key, flags) in other.blocks() {
+        for (key, marks) in other.blocks() {
             let position = self.position(key);
-            let target = &mut self.blocks[position];
-            for w in 0..BLOCK_CELLS / 64 {
-                target.passed[w] |= flags.passed[w];
-                target.hit[w] |= flags.hit[w];
+            if let Some(target) = self.blocks.get_mut(position) {
+                target.unite(marks);
             }
         }
         self
     }
 }
 
-/// Marks voxels in a [`ScanSets`], caching the last block.
-struct Marker<'a> {
-    sets: &'a mut ScanSets,
+impl ScanSets {
+    /// Whether a ray passed through `key`, and whether it holds an end point.
+    pub fn flags(&self, key: VoxelKey) -> (bool, bool) {
+        self.index
+            .get(&key.block())
+            .and_then(|&i| self.blocks.get(i))
+            .map_or((false, false), |block| block.get(key.cell_index()))
+    }
+}
+
+impl ScanLevels {
+    /// The sets of the points of `level` and up: exactly what [`scan_sets`] gives for them.
+    pub fn cut(&self, level: u16) -> ScanSets {
+        let mut sets = ScanSets::new();
+        for (key, levels) in self.blocks() {
+            let mut flags = BlockFlags::default();
+            for (i, (&passed, &hit)) in levels.passed.iter().zip(&levels.hit).enumerate() {
+                if passed >= level {
+                    flags.pass(i, level);
+                }
+                if hit >= level {
+                    flags.hit(i, level);
+                }
+            }
+            if flags != BlockFlags::default() {
+                let position = sets.position(key);
+                if let Some(block) = sets.blocks.get_mut(position) {
+                    *block = flags;
+                }
+            }
+        }
+        sets
+    }
+
+    /// The highest level of any marked voxel (0 when nothing is marked).
+    pub fn max_level(&self) -> u16 {
+        self.blocks
+            .iter()
+            .flat_map(|b| b.passed.iter().chain(&b.hit))
+            .copied()
+            .max()
+            .unwrap_or(0)
+    }
+}
+
+/// Marks voxels in a scan's record, caching the last block (the next voxel along a ray most
+/// likely lies in it again).
+struct Marker<'a, B> {
+    sets: &'a mut ScanBlocks<B>,
     last: Option<(BlockKey, usize)>,
 }
 
-impl Marker<'_> {
+impl<B: CellMarks> Marker<'_, B> {
     #[inline]
-    fn block(&mut self, key: VoxelKey) -> &mut BlockFlags {
+    fn block(&mut self, key: VoxelKey) -> Option<&mut B> {
         let block_key = key.block();
         let position = match self.last {
             Some((cached, position)) if cached == block_key => position,
@@ -98,19 +221,21 @@ impl Marker<'_> {
                 position
             }
         };
-        &mut self.sets.blocks[position]
+        self.sets.blocks.get_mut(position)
     }
 
     #[inline]
-    fn pass(&mut self, key: VoxelKey) {
-        let i = key.cell_index();
-        self.block(key).passed[i / 64] |= 1 << (i % 64);
+    fn pass(&mut self, key: VoxelKey, level: u16) {
+        if let Some(block) = self.block(key) {
+            block.pass(key.cell_index(), level);
+        }
     }
 
     #[inline]
-    fn hit(&mut self, key: VoxelKey) {
-        let i = key.cell_index();
-        self.block(key).hit[i / 64] |= 1 << (i % 64);
+    fn hit(&mut self, key: VoxelKey, level: u16) {
+        if let Some(block) = self.block(key) {
+            block.hit(key.cell_index(), level);
+        }
     }
 }
 
@@ -130,6 +255,27 @@ pub fn scan_sets(
     options: &IntegrationOptions,
     include: impl Fn(usize) -> bool + Sync,
 ) -> Result<(ScanSets, IntegrationStats)> {
+    walk_scan(cloud, resolution, options, |i| u16::from(include(i)))
+}
+
+/// The levels of one scan whose points carry levels (`level(i)`, 0 leaves point `i` out), in
+/// one walk of the rays: [`ScanLevels::cut`]`(k)` equals [`scan_sets`] of the points of level
+/// `k` and up. The alpha-cut map inserts its nested cuts this way. Errors as [`scan_sets`].
+pub fn scan_levels(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    options: &IntegrationOptions,
+    level: impl Fn(usize) -> u16 + Sync,
+) -> Result<(ScanLevels, IntegrationStats)> {
+    walk_scan(cloud, resolution, options, level)
+}
+
+fn walk_scan<B: CellMarks>(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    options: &IntegrationOptions,
+    level: impl Fn(usize) -> u16 + Sync,
+) -> Result<(ScanBlocks<B>, IntegrationStats)> {
     let options = options.validate()?;
     let origin = cloud.origin();
     resolution.key_of(&origin)?;
@@ -169,13 +315,14 @@ pub fn scan_sets(
         .points()
         .par_chunks(CHUNK)
         .enumerate()
-        .fold(ScanSets::new, |mut sets, (chunk_index, chunk)| {
+        .fold(ScanBlocks::<B>::new, |mut sets, (chunk_index, chunk)| {
             let mut marker = Marker {
                 sets: &mut sets,
                 last: None,
             };
             for (offset, point) in chunk.iter().enumerate() {
-                if !finite(point) || !include(chunk_index * CHUNK + offset) {
+                let level = level(chunk_index * CHUNK + offset);
+                if !finite(point) || level == 0 {
                     continue;
                 }
                 let p = single(point);
@@ -191,25 +338,25 @@ pub fn scan_sets(
                             origin32[1] + delta[1] / length * m,
                             origin32[2] + delta[2] / length * m,
                         ];
-                        walk_ray_octomap(resolution, origin32, end, |key| marker.pass(key));
+                        walk_ray_octomap(resolution, origin32, end, |key| marker.pass(key, level));
                     }
                     _ => {
-                        walk_ray_octomap(resolution, origin32, p, |key| marker.pass(key));
+                        walk_ray_octomap(resolution, origin32, p, |key| marker.pass(key, level));
                         let end = Point3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
                         if let Some(key) = resolution.try_key_of(&end) {
-                            marker.hit(key);
+                            marker.hit(key, level);
                         }
                     }
                 }
             }
             sets
         })
-        .reduce(ScanSets::new, ScanSets::union);
+        .reduce(ScanBlocks::<B>::new, ScanBlocks::union);
     let mut stats = IntegrationStats::default();
     for (i, p) in cloud.points().iter().enumerate() {
         if !finite(p) {
             stats.skipped += 1;
-        } else if include(i) {
+        } else if level(i) > 0 {
             stats.integrated += 1;
             stats.clipped += usize::from(max_range.is_some_and(|max| (p - origin).norm() > max));
         }
