@@ -25,6 +25,20 @@ fn fails(args: &[&str], status: i32, expected: &str) {
         stderr.to_lowercase().contains(&expected.to_lowercase()),
         "{args:?}: expected `{expected}` in: {stderr}"
     );
+    // Each cause once: no part of the message repeated.
+    let parts: Vec<&str> = stderr.trim().split(": ").filter(|p| p.len() > 8).collect();
+    for (i, part) in parts.iter().enumerate() {
+        assert!(
+            !parts[i + 1..].contains(part),
+            "{args:?}: `{part}` repeated in: {stderr}"
+        );
+    }
+    for path in args.iter().filter(|a| a.contains('/')) {
+        assert!(
+            stderr.matches(path).count() <= 1,
+            "{args:?}: `{path}` named twice in: {stderr}"
+        );
+    }
 }
 
 /// A fresh folder for one test.

@@ -74,10 +74,40 @@ pub fn run() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", describe(&error));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes on one line, each said once: library errors such as a failed
+/// read already name their cause in their own message, and a cause that begins with the path
+/// the context just named drops it (`writing a.bt` and `a.bt: No such file` give
+/// `writing a.bt: No such file`; `reading c.xyz` and `c.xyz:3: bad number` give
+/// `reading c.xyz:3: bad number`).
+fn describe(error: &anyhow::Error) -> String {
+    let mut message = error.to_string();
+    for cause in error.chain().skip(1) {
+        let text = cause.to_string();
+        if message.contains(&text) {
+            continue;
+        }
+        let rest = text
+            .match_indices(':')
+            .find(|&(at, _)| {
+                text.get(..at)
+                    .is_some_and(|head| !head.is_empty() && message.ends_with(head))
+            })
+            .and_then(|(at, _)| text.get(at..));
+        match rest {
+            Some(rest) => message.push_str(rest),
+            None => {
+                message.push_str(": ");
+                message.push_str(&text);
+            }
+        }
+    }
+    message
 }
 
 /// Parses `X,Y,Z` into a point.
