@@ -154,12 +154,21 @@ fn demo_refuses_an_output_path_that_is_a_file() {
 #[test]
 fn demo_writes_the_report_maps_and_figures() {
     let out = scratch("demo-run");
-    let run = fuzzyvox(&["demo", "--out", out.to_str().unwrap()]);
+    let run = fuzzyvox(&["demo", "--out", out.to_str().unwrap(), "--json"]);
     assert!(
         run.status.success(),
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    // --json prints what metrics.json holds, with the folder and the time, and no progress.
+    let printed = json(&run);
+    assert!(
+        run.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(printed["out"], out.to_str().unwrap());
+    assert!(printed["seconds"].as_f64().unwrap() > 0.0);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     for heading in ["## wall scenario", "## random scenario", "Planned flights"] {
         assert!(report.contains(heading), "report lacks {heading}");
@@ -167,6 +176,7 @@ fn demo_writes_the_report_maps_and_figures() {
     let metrics: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
     for scenario in ["wall", "random"] {
+        assert_eq!(printed[scenario], metrics[scenario], "{scenario}");
         for map in ["logodds", "alpha", "fuzzy"] {
             let m = &metrics[scenario]["maps"][map];
             assert!(m["occupied_f1"].is_number(), "{scenario}/{map}");

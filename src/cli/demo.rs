@@ -18,7 +18,9 @@ use super::eval::{experiment_config, run_with_bar};
 /// and the fuzzy map, from the same depth-stage output; flights are planned in every map and
 /// checked against the true scene, and the report compares everything side by side.
 #[derive(Args)]
-#[command(after_help = "Examples:\n  fuzzyvox demo\n  fuzzyvox demo --out my-demo --full")]
+#[command(
+    after_help = "Examples:\n  fuzzyvox demo\n  fuzzyvox demo --out my-demo --full\n  fuzzyvox demo --json > metrics.json"
+)]
 pub struct DemoArgs {
     /// Where to write the report, metrics, maps and figures.
     #[arg(long, default_value = "demo-out")]
@@ -27,6 +29,10 @@ pub struct DemoArgs {
     /// one (60 pairs, 30 flights).
     #[arg(long)]
     full: bool,
+    /// Print the metrics (what `metrics.json` holds, plus `out` and `seconds`) as one line of
+    /// JSON instead of the summary, without progress.
+    #[arg(long)]
+    json: bool,
 }
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
@@ -45,12 +51,14 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     );
     let mut all = serde_json::Map::new();
     for scenario in [scenario::wall()?, scenario::random(pairs, 1)?] {
-        eprintln!(
-            "[{:>5.1} s] {} scenario: {} stereo pairs ...",
-            started.elapsed().as_secs_f64(),
-            scenario.name,
-            scenario.pairs.len()
-        );
+        if !args.json {
+            eprintln!(
+                "[{:>5.1} s] {} scenario: {} stereo pairs ...",
+                started.elapsed().as_secs_f64(),
+                scenario.name,
+                scenario.pairs.len()
+            );
+        }
         let config = experiment_config(
             &scenario,
             0.2,
@@ -59,7 +67,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             flights,
             UnknownPolicy::Forbid,
         );
-        let output = run_with_bar(&scenario, &config, false)?;
+        let output = run_with_bar(&scenario, &config, args.json)?;
         let (section, _) = write_experiment(&args.out, &scenario, &output)?;
         report.push_str(&section);
         for (name, map) in &output.maps {
@@ -90,10 +98,15 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         &args.out.join("metrics.json"),
         serde_json::to_string_pretty(&all)?.as_bytes(),
     )?;
+    let seconds = started.elapsed().as_secs_f64();
+    if args.json {
+        all.insert("out".into(), args.out.display().to_string().into());
+        all.insert("seconds".into(), seconds.into());
+        return super::print_json(&serde_json::Value::Object(all));
+    }
     println!(
-        "wrote {} (report.md, metrics.json, maps and figures) in {:.1} s",
+        "wrote {} (report.md, metrics.json, maps and figures) in {seconds:.1} s",
         args.out.display(),
-        started.elapsed().as_secs_f64()
     );
     Ok(())
 }
