@@ -1,5 +1,5 @@
-//! Integration speed on real data: fuzzy and log-odds ray integration of OctoMap's `scan.dat`,
-//! and projective integration of one 640×480 7-Scenes depth frame.
+//! Integration speed on real data: fuzzy, log-odds and alpha-cut ray integration of OctoMap's
+//! `scan.dat`, and projective integration of one 640×480 7-Scenes depth frame.
 //!
 //! Needs `FUZZYVOX_DATA` (the shared data folder); without it the benchmarks say so and skip.
 //! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench integrate`.
@@ -7,12 +7,14 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use fuzzyvox::integrate::scan_sets;
 use fuzzyvox::io::read_text_cloud;
 use fuzzyvox::io::rgbd::{
     kinect_interval_image, read_depth_png_mm, read_intrinsics_txt, read_pose_txt,
 };
 use fuzzyvox::{
-    DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions, LogOddsConfig, LogOddsMap, VoxelMap,
+    AlphaConfig, AlphaCutMap, DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions, LogOddsConfig,
+    LogOddsMap, VoxelMap,
 };
 use nalgebra::Point3;
 
@@ -62,6 +64,50 @@ fn log_odds_integration(c: &mut Criterion) {
     group.finish();
 }
 
+/// The alpha-cut map's insertion (one walk of the rays, then every cut applied) beside one
+/// walk per cut, the definition it reproduces, on `scan.dat` with confidences spread evenly
+/// over (0, 1] so that points fall in one to ten cuts.
+fn alpha_integration(c: &mut Criterion) {
+    let Some(dir) = data_dir() else { return };
+    let cloud = read_text_cloud(&dir.join("octomap-samples/scan.dat"), Point3::origin())
+        .expect("reading scan.dat");
+    let confidence: Vec<f32> = (0..cloud.len())
+        .map(|i| ((i * 37) % 100 + 1) as f32 / 100.0)
+        .collect();
+    let cloud = cloud
+        .with_confidence(confidence)
+        .expect("one confidence per point");
+    let options = IntegrationOptions::default();
+    let mut group = c.benchmark_group("alpha_ray_scan_dat");
+    group.sample_size(10);
+    for resolution in [0.1, 0.05] {
+        let config = AlphaConfig::new(resolution).unwrap();
+        group.bench_function(format!("one_walk/{resolution}m"), |b| {
+            b.iter(|| {
+                let mut map = AlphaCutMap::new(config).unwrap();
+                map.integrate_cloud(&cloud, &options).unwrap();
+                map
+            })
+        });
+        let cuts: Vec<u32> = (0..cloud.len())
+            .map(|i| config.cuts_of(cloud.confidence_of(i)))
+            .collect();
+        group.bench_function(format!("walk_per_cut/{resolution}m"), |b| {
+            b.iter(|| {
+                let mut map = LogOddsMap::new(LogOddsConfig::new(resolution).unwrap()).unwrap();
+                let resolution = map.resolution();
+                for k in 1..=config.cuts {
+                    let (sets, _) =
+                        scan_sets(&cloud, &resolution, &options, |i| cuts[i] >= k).unwrap();
+                    map.apply_sets(&sets);
+                }
+                map
+            })
+        });
+    }
+    group.finish();
+}
+
 fn projective_integration(c: &mut Criterion) {
     let Some(dir) = data_dir() else { return };
     let scene = dir.join("rgbd-7scenes-redkitchen");
@@ -92,6 +138,7 @@ criterion_group!(
     benches,
     ray_integration,
     log_odds_integration,
+    alpha_integration,
     projective_integration
 );
 criterion_main!(benches);

@@ -115,7 +115,8 @@ pub struct ScanBlocks<B> {
 pub type ScanSets = ScanBlocks<BlockFlags>;
 
 /// A scan whose points carry levels: per voxel, the highest level of a ray through it and of
-/// an end point in it. [`ScanLevels::cut`] gives the sets of the points of one level and up.
+/// an end point in it. The scan of the points of level `k` and up passes through the voxels
+/// whose ray level is at least `k` and ends in those whose end-point level is at least `k`.
 pub type ScanLevels = ScanBlocks<BlockLevels>;
 
 impl<B: CellMarks> ScanBlocks<B> {
@@ -164,41 +165,6 @@ impl ScanSets {
             .get(&key.block())
             .and_then(|&i| self.blocks.get(i))
             .map_or((false, false), |block| block.get(key.cell_index()))
-    }
-}
-
-impl ScanLevels {
-    /// The sets of the points of `level` and up: exactly what [`scan_sets`] gives for them.
-    pub fn cut(&self, level: u16) -> ScanSets {
-        let mut sets = ScanSets::new();
-        for (key, levels) in self.blocks() {
-            let mut flags = BlockFlags::default();
-            for (i, (&passed, &hit)) in levels.passed.iter().zip(&levels.hit).enumerate() {
-                if passed >= level {
-                    flags.pass(i, level);
-                }
-                if hit >= level {
-                    flags.hit(i, level);
-                }
-            }
-            if flags != BlockFlags::default() {
-                let position = sets.position(key);
-                if let Some(block) = sets.blocks.get_mut(position) {
-                    *block = flags;
-                }
-            }
-        }
-        sets
-    }
-
-    /// The highest level of any marked voxel (0 when nothing is marked).
-    pub fn max_level(&self) -> u16 {
-        self.blocks
-            .iter()
-            .flat_map(|b| b.passed.iter().chain(&b.hit))
-            .copied()
-            .max()
-            .unwrap_or(0)
     }
 }
 
@@ -259,8 +225,9 @@ pub fn scan_sets(
 }
 
 /// The levels of one scan whose points carry levels (`level(i)`, 0 leaves point `i` out), in
-/// one walk of the rays: [`ScanLevels::cut`]`(k)` equals [`scan_sets`] of the points of level
-/// `k` and up. The alpha-cut map inserts its nested cuts this way. Errors as [`scan_sets`].
+/// one walk of the rays; the voxels of level `k` and up are exactly what [`scan_sets`] of the
+/// points of level `k` and up marks. The alpha-cut map inserts its nested cuts this way
+/// (`LogOddsMap::apply_levels`). Errors as [`scan_sets`].
 pub fn scan_levels(
     cloud: &PointCloud,
     resolution: &Resolution,

@@ -64,7 +64,9 @@ impl AlphaConfig {
 ///
 /// The rays are walked once per scan, not once per cut: each voxel records the highest cut
 /// of a ray through it and of an end point in it, and cut `k`'s scan is the voxels of level `k`
-/// and up (the same sets, applied in the same order; a test checks the cells bit for bit).
+/// and up. Voxels do not interact, so each voxel then takes its cuts' updates in order, hits
+/// first ([`LogOddsMap::apply_levels`]); a test checks the cells bit for bit against
+/// inserting every cut as its own scan.
 ///
 /// A cloud without confidences is inserted at full confidence.
 #[derive(Clone, Debug)]
@@ -125,9 +127,7 @@ impl VoxelMap for AlphaCutMap {
         let (levels, mut stats) = scan_levels(cloud, &resolution, options, |i| {
             u16::try_from(self.config.cuts_of(cloud.confidence_of(i))).unwrap_or(u16::MAX)
         })?;
-        for k in 1..=levels.max_level() {
-            stats.voxels_updated += self.inner.apply_sets(&levels.cut(k));
-        }
+        stats.voxels_updated = self.inner.apply_levels(&levels);
         Ok(stats)
     }
 

@@ -5,7 +5,7 @@ use super::VoxelMap;
 use super::counts::VoxelCounts;
 use crate::error::{Error, Result, finite};
 use crate::integrate::{
-    DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanSets, scan_sets,
+    DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanLevels, ScanSets, scan_sets,
 };
 use crate::measures::{MeasureConfig, Memberships};
 use crate::storage::{BlockGrid, Resolution, VoxelKey};
@@ -192,6 +192,40 @@ impl LogOddsMap {
                         block.summary.moved(classify(before), classify(*cell));
                         updated += 1;
                     }
+                }
+                updated
+            })
+    }
+
+    /// Applies a scan whose points carry levels as its nested cuts, cut 1 first: cut `k` is the
+    /// scan of the points of level `k` and up (a voxel is hit in it when an end point of level
+    /// `k` or more lies in it, else missed when such a ray passed through). Voxels do not
+    /// interact, so each voxel takes its own run of updates (its hits, then its misses) and the
+    /// map is bit for bit what applying the cuts' sets one after another gives, without
+    /// building them. Returns the voxel updates summed over the cuts.
+    pub fn apply_levels(&mut self, levels: &ScanLevels) -> usize {
+        let (hit_update, miss, min, max) = (self.hit, self.miss, self.min, self.max);
+        let measures = self.config.measures;
+        let classify = |c: LogOdds| measures.classify(c.memberships());
+        self.grid
+            .update_blocks(levels.blocks().collect(), |block, marks| {
+                let mut updated = 0;
+                let cells = block.cells.iter_mut().zip(&marks.passed).zip(&marks.hit);
+                for ((cell, &passed), &hit) in cells {
+                    let runs = passed.max(hit);
+                    if runs == 0 {
+                        continue;
+                    }
+                    let before = *cell;
+                    let mut current = if before.is_observed() { before.0 } else { 0.0 };
+                    for k in 1..=runs {
+                        // Add, then clamp, in single precision, once per cut, as `apply_sets`.
+                        let update = if k <= hit { hit_update } else { miss };
+                        current = (current + update).clamp(min, max);
+                    }
+                    cell.0 = current;
+                    block.summary.moved(classify(before), classify(*cell));
+                    updated += usize::from(runs);
                 }
                 updated
             })
