@@ -7,7 +7,9 @@ use super::evidence::{
 };
 use crate::error::{Error, Result};
 use crate::ops::TConorm;
-use crate::storage::{AccessorMut, BLOCK_CELLS, BLOCK_SIDE, Block, BlockKey, KeyBox, Resolution};
+use crate::storage::{
+    AccessorMut, BLOCK_CELLS, BLOCK_SIDE, Block, BlockKey, KeyBox, Resolution, VoxelKey,
+};
 
 /// Largest frustum bounding box, in blocks, that one depth image may span (a guard against
 /// absurd depths; ordinary frames span thousands).
@@ -111,6 +113,11 @@ pub fn depth_evidence(
 /// kernel is deliberately weak when the interval is wide; the hit keeps the most likely point
 /// as strong as the paper's confidence-weighted point insertion. Evidence only rises, so the
 /// order of pixels does not matter.
+///
+/// Rows are back-projected in parallel. Neighbouring pixels of a row mostly land in the same
+/// voxel, so each run of them keeps its highest confidence, and the weighted evidence (a
+/// generator and its inverse, the costly part) is computed once per run: the weighting rises
+/// with confidence, so that is the largest of the run's hits.
 fn mark_end_points(
     evidence: &mut ScanEvidence,
     frame: &DepthFrame,
@@ -122,19 +129,38 @@ fn mark_end_points(
     let k = frame.intrinsics();
     let pose = frame.world_from_camera();
     let width = k.width() as usize;
+    let rows: Vec<Vec<(VoxelKey, f32)>> = pixels
+        .par_chunks(width.max(1))
+        .enumerate()
+        .map(|(v, row)| {
+            let mut runs: Vec<(VoxelKey, f32)> = Vec::new();
+            for (u, p) in row.iter().enumerate() {
+                if !p.is_valid() || p.height <= 0.0 {
+                    continue;
+                }
+                let point = pose * k.back_project(u as f64, v as f64, f64::from(p.depth));
+                // A point outside the key range was already refused by the frustum box; skip it.
+                let Ok(key) = resolution.key_of(&point) else {
+                    continue;
+                };
+                match runs.last_mut() {
+                    Some((last, confidence)) if *last == key => {
+                        *confidence = confidence.max(p.confidence);
+                    }
+                    _ => runs.push((key, p.confidence)),
+                }
+            }
+            // Each run's highest confidence becomes its hit.
+            for (_, value) in &mut runs {
+                *value = model.occupied(operator, *value, 1.0);
+            }
+            runs
+        })
+        .collect();
     let mut cells = AccessorMut::new(evidence);
-    for (i, p) in pixels.iter().enumerate() {
-        if !p.is_valid() || p.height <= 0.0 {
-            continue;
-        }
-        let (u, v) = ((i % width) as f64, (i / width) as f64);
-        let point = pose * k.back_project(u, v, f64::from(p.depth));
-        // A point outside the key range was already refused by the frustum box; skip it.
-        if let Ok(key) = resolution.key_of(&point) {
-            let hit = model.occupied(operator, p.confidence, 1.0);
-            let cell = cells.get_or_insert(key);
-            cell.occupied = cell.occupied.max(hit);
-        }
+    for (key, hit) in rows.iter().flatten() {
+        let cell = cells.get_or_insert(*key);
+        cell.occupied = cell.occupied.max(*hit);
     }
 }
 
