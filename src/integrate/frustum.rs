@@ -586,4 +586,71 @@ mod tests {
             assert!(with_evidence > 0, "frame {index} observes nothing");
         }
     }
+
+    /// The end-point hits, one weighted evidence per run of pixels in a voxel and rows in
+    /// parallel, against the definition: every pixel's hit raised into its voxel one by one.
+    /// Smooth depths put many neighbouring pixels in one voxel; confidences vary within runs.
+    #[test]
+    fn end_point_hits_equal_one_hit_per_pixel() {
+        let k = PinholeIntrinsics::new(48, 36, 200.0, 200.0, 23.5, 17.5).unwrap();
+        let pose = Isometry3::from_parts(
+            Translation3::new(0.2, -0.1, 0.5),
+            UnitQuaternion::from_euler_angles(0.2, -0.3, 0.4),
+        );
+        let n = (k.width() * k.height()) as usize;
+        let depth: Vec<f32> = (0..n)
+            .map(|i| {
+                let (u, v) = ((i % 48) as f32, (i / 48) as f32);
+                if i % 97 == 5 {
+                    f32::NAN
+                } else {
+                    1.0 + 0.02 * u + 0.01 * v
+                }
+            })
+            .collect();
+        let image = IntervalDepthImage::from_depth(k.width(), k.height(), &depth, |z| {
+            let c = 0.3 + 0.7 * ((z * 1000.0) as u32 % 13) as f32 / 13.0;
+            (0.95 * z, 1.05 * z, c)
+        })
+        .unwrap();
+        let frame = DepthFrame::new(k, pose, image).unwrap();
+        let resolution = Resolution::new(0.05).unwrap();
+        let operator = TConorm::default();
+        let model = EvidenceModel::default();
+        let half_diagonal = (0.5 * 3f64.sqrt() * resolution.size()) as f32;
+        let pixels: Vec<PixelEvidence> = (0..n)
+            .map(|i| {
+                frame.image().pixel(i).map_or(PixelEvidence::NONE, |p| {
+                    PixelEvidence::new(p, &model, &operator, f32::INFINITY, half_diagonal)
+                })
+            })
+            .collect();
+        let mut fast = ScanEvidence::new();
+        mark_end_points(&mut fast, &frame, &pixels, &resolution, &model, &operator);
+        let mut reference = ScanEvidence::new();
+        let mut cells = AccessorMut::new(&mut reference);
+        let mut runs_shared = 0;
+        for (i, p) in pixels.iter().enumerate() {
+            if !p.is_valid() {
+                continue;
+            }
+            let (u, v) = ((i % 48) as f64, (i / 48) as f64);
+            let point = pose * k.back_project(u, v, f64::from(p.depth));
+            let key = resolution.key_of(&point).unwrap();
+            let hit = model.occupied(&operator, p.confidence, 1.0);
+            let cell = cells.get_or_insert(key);
+            runs_shared += usize::from(cell.occupied > 0.0);
+            cell.occupied = cell.occupied.max(hit);
+        }
+        assert!(runs_shared > n / 2, "pixels rarely share a voxel");
+        let a: Vec<_> = fast
+            .cells()
+            .map(|(k, c)| (k, c.occupied.to_bits()))
+            .collect();
+        let b: Vec<_> = reference
+            .cells()
+            .map(|(k, c)| (k, c.occupied.to_bits()))
+            .collect();
+        assert_eq!(a, b);
+    }
 }
