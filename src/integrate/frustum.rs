@@ -312,6 +312,77 @@ impl TileReach {
 }
 
 /// The camera as seen from the voxel grid: everything needed to project voxel centres.
+/// The frustum as a convex solid: the camera centre and the image's four corner rays cut at
+/// the largest reach, in the camera frame. [`Pyramid::may_meet_cube`] is an exact
+/// separating-axis test against a cube (face normals of both and the cross products of their
+/// edges), so it drops only cubes that share no point with the frustum; every voxel that can
+/// receive evidence lies inside it. It is what culls blocks beside a thin, grazing frustum
+/// (a camera whose principal point lies far off its image), where the four side planes are
+/// nearly one plane and the per-plane tests keep a whole sheet of blocks.
+struct Pyramid {
+    /// Separating axes, each with the frustum's extent along it and the cube's half-width
+    /// along it per unit of half side.
+    axes: Vec<(Vector3<f64>, f64, f64, f64)>,
+}
+
+impl Pyramid {
+    fn new(view: &CameraView, reach: f64) -> Self {
+        let (w, h) = (f64::from(view.width), f64::from(view.height));
+        let corner = |u: f64, v: f64| {
+            Vector3::new(
+                (u - view.cx) / view.fx * reach,
+                (v - view.cy) / view.fy * reach,
+                reach,
+            )
+        };
+        let far = [
+            corner(-0.5, -0.5),
+            corner(w - 0.5, -0.5),
+            corner(w - 0.5, h - 0.5),
+            corner(-0.5, h - 0.5),
+        ];
+        let vertices = [Vector3::zeros(), far[0], far[1], far[2], far[3]];
+        let cube = [0, 1, 2].map(|k| view.camera_from_world.column(k).into_owned());
+        let mut candidates: Vec<Vector3<f64>> = cube.to_vec();
+        candidates.extend(view.sides);
+        candidates.push(Vector3::z());
+        let edges = [far[0], far[1], far[2], far[3], Vector3::x(), Vector3::y()];
+        for edge in edges {
+            for a in &cube {
+                candidates.push(edge.cross(a));
+            }
+        }
+        let axes = candidates
+            .into_iter()
+            .filter_map(|axis| {
+                let norm = axis.norm();
+                (norm.is_finite() && norm > 1e-12).then(|| axis / norm)
+            })
+            .map(|axis| {
+                let along = vertices.map(|v| axis.dot(&v));
+                let low = along.iter().copied().fold(f64::INFINITY, f64::min);
+                let high = along.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let spread: f64 = cube.iter().map(|a| axis.dot(a).abs()).sum();
+                (axis, low, high, spread)
+            })
+            .collect();
+        Self { axes }
+    }
+
+    /// Whether the cube with lowest corner `corner` (world) and edge `side` may share a point
+    /// with the frustum; `false` only when an axis separates them by more than a rounding
+    /// margin.
+    fn may_meet_cube(&self, view: &CameraView, corner: Point3<f64>, side: f64) -> bool {
+        let center = view.to_camera(&(corner + Vector3::repeat(0.5 * side)));
+        self.axes.iter().all(|(axis, low, high, spread)| {
+            let at = axis.dot(&center);
+            let half = 0.5 * side * spread;
+            let margin = 1e-9 * (at.abs() + half + low.abs() + high.abs()) + 1e-9;
+            at - half <= high + margin && at + half >= low - margin
+        })
+    }
+}
+
 struct CameraView {
     camera_from_world: Matrix3<f64>,
     camera_in_world: Vector3<f64>,
@@ -368,20 +439,27 @@ impl CameraView {
         let groups = |lo: i32, hi: i32| lo.div_euclid(GROUP)..=hi.div_euclid(GROUP);
         let within =
             |g: i32, lo: i32, hi: i32| (g * GROUP).max(lo)..=(g * GROUP + GROUP - 1).min(hi);
+        let pyramid = Pyramid::new(self, f64::from(tiles.max_reach));
+        let block_side = BLOCK_SIDE as f64 * self.resolution.size();
         let mut blocks = Vec::new();
         for gz in groups(lo.z, hi.z) {
             for gy in groups(lo.y, hi.y) {
                 for gx in groups(lo.x, hi.x) {
                     let first = BlockKey::new(gx * GROUP, gy * GROUP, gz * GROUP);
                     let corner = self.resolution.corner(first.origin());
-                    if !self.cube_may_be_observed(corner, group_side, tiles) {
+                    if !self.cube_may_be_observed(corner, group_side, tiles)
+                        || !pyramid.may_meet_cube(self, corner, group_side)
+                    {
                         continue;
                     }
                     for z in within(gz, lo.z, hi.z) {
                         for y in within(gy, lo.y, hi.y) {
                             for x in within(gx, lo.x, hi.x) {
                                 let key = BlockKey::new(x, y, z);
-                                if self.block_may_be_observed(key, tiles) {
+                                let corner = self.resolution.corner(key.origin());
+                                if self.block_may_be_observed(key, tiles)
+                                    && pyramid.may_meet_cube(self, corner, block_side)
+                                {
                                     blocks.push(key);
                                 }
                             }
@@ -544,6 +622,15 @@ mod tests {
                     UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0),
                 ),
             ),
+            // A tiny image whose principal point lies 1,000 px away (fuzzing found one 8,000 px
+            // away): a needle of a frustum, tens of metres long and grazing the camera plane.
+            (
+                PinholeIntrinsics::new(2, 3, 64.125, 31.875, 819.875, 816.375).unwrap(),
+                Isometry3::from_parts(
+                    Translation3::new(0.0, -0.01, -241.59),
+                    UnitQuaternion::from_euler_angles(-1e-3, -1e-3, -0.768),
+                ),
+            ),
         ];
         let resolution = Resolution::new(0.1).unwrap();
         let model = EvidenceModel::default();
@@ -571,7 +658,7 @@ mod tests {
             let all: Vec<BlockKey> = frustum.blocks().collect();
             assert!(kept.len() < all.len(), "frame {index}: nothing culled");
             let mut with_evidence = 0;
-            for key in all {
+            for &key in &all {
                 let evidence =
                     camera.block_evidence(key, &pixels, &model, &operator, half_diagonal);
                 if evidence.is_some() {
@@ -584,6 +671,16 @@ mod tests {
                 }
             }
             assert!(with_evidence > 0, "frame {index} observes nothing");
+            // The separating-axis test keeps the needle's blocks, not the sheet of blocks
+            // around it that the side planes alone let through.
+            if index == 3 {
+                assert!(
+                    kept.len() * 20 < all.len(),
+                    "frame {index}: {} of {} blocks kept",
+                    kept.len(),
+                    all.len()
+                );
+            }
         }
     }
 
