@@ -358,12 +358,15 @@ impl Pyramid {
                 let norm = axis.norm();
                 (norm.is_finite() && norm > 1e-12).then(|| axis / norm)
             })
-            .map(|axis| {
+            .filter_map(|axis| {
                 let along = vertices.map(|v| axis.dot(&v));
                 let low = along.iter().copied().fold(f64::INFINITY, f64::min);
                 let high = along.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 let spread: f64 = cube.iter().map(|a| axis.dot(a).abs()).sum();
-                (axis, low, high, spread)
+                // An axis whose extent overflowed separates nothing reliably: leave it out, so
+                // the test stays conservative.
+                (low.is_finite() && high.is_finite() && spread.is_finite())
+                    .then_some((axis, low, high, spread))
             })
             .collect();
         Self { axes }
