@@ -349,56 +349,63 @@ fn a_camera_outside_the_key_range_is_an_error_in_every_map() {
     }
 }
 
+/// Integrates a frame whose pixels all lie at 3 m (interval 2.98–3.03 m), seen by a skewed
+/// camera, into a new fuzzy map at 0.05 m. The five-second bound only guards against a hang; the culling test in
+/// `src/integrate/frustum.rs` checks how many blocks such frustums keep.
+fn integrate_skewed(
+    k: PinholeIntrinsics,
+    pose: Isometry3<f64>,
+) -> (fuzzyvox::IntegrationStats, FuzzyMap) {
+    let n = (k.width() * k.height()) as usize;
+    let image = IntervalDepthImage::new(
+        k.width(),
+        k.height(),
+        vec![2.98; n],
+        vec![3.0; n],
+        vec![3.03; n],
+        vec![0.78; n],
+    )
+    .unwrap();
+    let frame = DepthFrame::new(k, pose, image).unwrap();
+    let mut map = FuzzyMap::new(FuzzyConfig::new(0.05).unwrap()).unwrap();
+    let started = std::time::Instant::now();
+    let stats = map.integrate_depth(&frame, &Default::default()).unwrap();
+    let seconds = started.elapsed().as_secs_f64();
+    assert!(seconds < 5.0, "{n} pixels took {seconds:.1} s");
+    (stats, map)
+}
+
 #[test]
 fn a_skewed_camera_whose_frustum_box_is_huge_integrates_quickly() {
     // Found by fuzzing: one pixel, a principal point 8,000 px off the image and fy = 5e46 make a
     // sliver of a frustum 780 m long whose bounding box holds 19 million blocks, all near the
     // camera plane. Culling used to test every block (7 s for one pixel); whole groups of blocks
     // beside the frustum's side planes are now skipped.
-    let k = PinholeIntrinsics::new(1, 1, 31.875, 5.03e46, 8191.875, 8164.875).unwrap();
-    let image =
-        IntervalDepthImage::new(1, 1, vec![2.98], vec![3.0], vec![3.03], vec![0.78]).unwrap();
-    let pose = Isometry3::from_parts(
-        Translation3::new(0.06, -241.59, -20.49),
-        UnitQuaternion::from_euler_angles(-1e-3, -1e-3, 10.239),
+    let (stats, _) = integrate_skewed(
+        PinholeIntrinsics::new(1, 1, 31.875, 5.03e46, 8191.875, 8164.875).unwrap(),
+        Isometry3::from_parts(
+            Translation3::new(0.06, -241.59, -20.49),
+            UnitQuaternion::from_euler_angles(-1e-3, -1e-3, 10.239),
+        ),
     );
-    let frame = DepthFrame::new(k, pose, image).unwrap();
-    let mut map = FuzzyMap::new(FuzzyConfig::new(0.05).unwrap()).unwrap();
-    let started = std::time::Instant::now();
-    let stats = map.integrate_depth(&frame, &Default::default()).unwrap();
-    let seconds = started.elapsed().as_secs_f64();
     assert_eq!(stats.integrated, 1);
-    assert!(seconds < 5.0, "one pixel took {seconds:.1} s");
 
     // Found by fuzzing later: six pixels whose frustum is a needle grazing the camera plane,
     // 860 m long. The side planes are then nearly one plane, and the blocks of a whole sheet
     // around the needle passed them (680,000 blocks, 1.5 s); the separating-axis test keeps
-    // the needle's own blocks (the count is checked in the library's culling test).
-    let k = PinholeIntrinsics::new(2, 3, 64.125, 31.875, 8191.875, 8165.375).unwrap();
-    let image = IntervalDepthImage::new(
-        2,
-        3,
-        vec![2.98; 6],
-        vec![3.0; 6],
-        vec![3.03; 6],
-        vec![0.78; 6],
-    )
-    .unwrap();
-    let pose = Isometry3::from_parts(
-        Translation3::new(0.0, -0.01, -241.59),
-        UnitQuaternion::from_euler_angles(-1e-3, -1e-3, -0.768),
+    // the needle's own blocks.
+    let (stats, map) = integrate_skewed(
+        PinholeIntrinsics::new(2, 3, 64.125, 31.875, 8191.875, 8165.375).unwrap(),
+        Isometry3::from_parts(
+            Translation3::new(0.0, -0.01, -241.59),
+            UnitQuaternion::from_euler_angles(-1e-3, -1e-3, -0.768),
+        ),
     );
-    let frame = DepthFrame::new(k, pose, image).unwrap();
-    let mut map = FuzzyMap::new(FuzzyConfig::new(0.05).unwrap()).unwrap();
-    let started = std::time::Instant::now();
-    let stats = map.integrate_depth(&frame, &Default::default()).unwrap();
-    let seconds = started.elapsed().as_secs_f64();
     assert_eq!(stats.integrated, 6);
     assert!(
         map.counts().occupied > 0,
         "the six surface points are mapped"
     );
-    assert!(seconds < 5.0, "six pixels took {seconds:.1} s");
 }
 
 // ---------------------------------------------------------------------------------------------

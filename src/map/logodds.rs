@@ -8,7 +8,7 @@ use crate::integrate::{
     DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanLevels, ScanSets, scan_sets,
 };
 use crate::measures::{MeasureConfig, Memberships};
-use crate::storage::{BlockGrid, Resolution, VoxelKey};
+use crate::storage::{Block, BlockGrid, Resolution, VoxelKey};
 
 /// One log-odds cell: `ln(p / (1 - p))` of being occupied, NaN when never observed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -131,6 +131,40 @@ pub struct LogOddsMap {
     grid: BlockGrid<LogOdds>,
 }
 
+/// One cell's updates in a scan, shared by [`LogOddsMap::apply_sets`] and
+/// [`LogOddsMap::apply_levels`].
+#[derive(Clone, Copy)]
+struct CellUpdates {
+    hit: f32,
+    miss: f32,
+    min: f32,
+    max: f32,
+    measures: MeasureConfig,
+}
+
+impl CellUpdates {
+    /// Gives cell `i` of `block` `hits` hit updates, then misses up to `total` updates, each an
+    /// add then a clamp in single precision as OctoMap's `updateNodeLogOdds` does, and keeps the
+    /// block's class counts current without reclassifying every cell.
+    #[inline(always)]
+    fn apply(self, block: &mut Block<LogOdds>, i: usize, hits: u16, total: u16) {
+        let Some(cell) = block.cells.get_mut(i) else {
+            return;
+        };
+        let before = *cell;
+        let mut current = if before.is_observed() { before.0 } else { 0.0 };
+        for k in 1..=total {
+            let update = if k <= hits { self.hit } else { self.miss };
+            current = (current + update).clamp(self.min, self.max);
+        }
+        cell.0 = current;
+        let classify = |c: LogOdds| self.measures.classify(c.memberships());
+        block
+            .summary
+            .moved(classify(before), classify(LogOdds(current)));
+    }
+}
+
 impl LogOddsMap {
     /// An empty map.
     pub fn new(config: LogOddsConfig) -> Result<Self> {
@@ -169,11 +203,20 @@ impl LogOddsMap {
         self.grid.cell(key).copied().unwrap_or_default()
     }
 
+    /// The per-cell update that both appliers share.
+    fn updates(&self) -> CellUpdates {
+        CellUpdates {
+            hit: self.hit,
+            miss: self.miss,
+            min: self.min,
+            max: self.max,
+            measures: self.config.measures,
+        }
+    }
+
     /// Applies one scan's sets: one clamped update per voxel. Returns the voxels updated.
     pub fn apply_sets(&mut self, sets: &ScanSets) -> usize {
-        let (hit_update, miss, min, max) = (self.hit, self.miss, self.min, self.max);
-        let measures = self.config.measures;
-        let classify = |c: LogOdds| measures.classify(c.memberships());
+        let updates = self.updates();
         self.grid
             .update_blocks(sets.blocks().collect(), |block, flags| {
                 let mut updated = 0;
@@ -183,13 +226,7 @@ impl LogOddsMap {
                         let bit = marked.trailing_zeros() as usize;
                         marked &= marked - 1;
                         let hit = flags.hit[word] & (1 << bit) != 0;
-                        let cell = &mut block.cells[word * 64 + bit];
-                        let before = *cell;
-                        let current = if before.is_observed() { before.0 } else { 0.0 };
-                        // Add, then clamp, in single precision, as OctoMap's updateNodeLogOdds does.
-                        cell.0 = (current + if hit { hit_update } else { miss }).clamp(min, max);
-                        // Keep the block's class counts current without reclassifying every cell.
-                        block.summary.moved(classify(before), classify(*cell));
+                        updates.apply(block, word * 64 + bit, u16::from(hit), 1);
                         updated += 1;
                     }
                 }
@@ -204,28 +241,16 @@ impl LogOddsMap {
     /// map is bit for bit what applying the cuts' sets one after another gives, without
     /// building them. Returns the voxel updates summed over the cuts.
     pub fn apply_levels(&mut self, levels: &ScanLevels) -> usize {
-        let (hit_update, miss, min, max) = (self.hit, self.miss, self.min, self.max);
-        let measures = self.config.measures;
-        let classify = |c: LogOdds| measures.classify(c.memberships());
+        let updates = self.updates();
         self.grid
             .update_blocks(levels.blocks().collect(), |block, marks| {
                 let mut updated = 0;
-                let cells = block.cells.iter_mut().zip(&marks.passed).zip(&marks.hit);
-                for ((cell, &passed), &hit) in cells {
-                    let runs = passed.max(hit);
-                    if runs == 0 {
-                        continue;
+                for (i, (&passed, &hit)) in marks.passed.iter().zip(&marks.hit).enumerate() {
+                    let cuts = passed.max(hit);
+                    if cuts > 0 {
+                        updates.apply(block, i, hit, cuts);
+                        updated += usize::from(cuts);
                     }
-                    let before = *cell;
-                    let mut current = if before.is_observed() { before.0 } else { 0.0 };
-                    for k in 1..=runs {
-                        // Add, then clamp, in single precision, once per cut, as `apply_sets`.
-                        let update = if k <= hit { hit_update } else { miss };
-                        current = (current + update).clamp(min, max);
-                    }
-                    cell.0 = current;
-                    block.summary.moved(classify(before), classify(*cell));
-                    updated += usize::from(runs);
                 }
                 updated
             })
