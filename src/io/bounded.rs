@@ -62,6 +62,56 @@ pub(crate) fn read_line(
     Ok(read)
 }
 
+/// The content lines of a text file, one at a time: trimmed, with blank lines and `#` comments
+/// skipped. Lines are read as bytes, not with `read_line`, so that a binary file is a parse
+/// error naming its line rather than an I/O error; a line longer than [`MAX_LINE_BYTES`] or not
+/// UTF-8 is such an error.
+pub(crate) struct ContentLines<'p, R> {
+    reader: R,
+    path: &'p Path,
+    bytes: Vec<u8>,
+    line_number: usize,
+}
+
+impl<'p, R: BufRead> ContentLines<'p, R> {
+    /// Lines of `reader`; errors name `path`.
+    pub(crate) fn new(reader: R, path: &'p Path) -> Self {
+        Self {
+            reader,
+            path,
+            bytes: Vec::new(),
+            line_number: 0,
+        }
+    }
+
+    /// The next content line with its 1-based number, `None` at the end.
+    pub(crate) fn next_line(&mut self) -> Result<Option<(usize, &str)>> {
+        loop {
+            let next = self.line_number + 1;
+            if read_line(&mut self.reader, &mut self.bytes, self.path, next)? == 0 {
+                return Ok(None);
+            }
+            self.line_number = next;
+            let line = self.text()?.trim();
+            if !(line.is_empty() || line.starts_with('#')) {
+                break;
+            }
+        }
+        // Taken again after the loop: a borrow returned from inside it would outlive the next
+        // turn's read.
+        Ok(Some((self.line_number, self.text()?.trim())))
+    }
+
+    /// The line just read, as text.
+    fn text(&self) -> Result<&str> {
+        std::str::from_utf8(&self.bytes).map_err(|_| Error::Parse {
+            path: self.path.to_path_buf(),
+            line: self.line_number,
+            message: "not UTF-8 text (a binary file?)".into(),
+        })
+    }
+}
+
 /// Reads a whole binary file, which must be a regular file: its size is then known and bounds
 /// the allocation, where a device such as `/dev/zero` would never end.
 pub(crate) fn read_regular(path: &Path) -> Result<Vec<u8>> {

@@ -3,7 +3,7 @@ use std::path::Path;
 
 use nalgebra::Point3;
 
-use super::bounded::read_line;
+use super::bounded::ContentLines;
 use crate::error::{Error, Result};
 use crate::integrate::PointCloud;
 
@@ -28,7 +28,7 @@ pub fn parse_text_cloud(bytes: &[u8], origin: Point3<f64>) -> Result<PointCloud>
     parse_cloud(bytes, Path::new("<memory>"), origin)
 }
 
-fn parse_cloud(mut reader: impl BufRead, path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
+fn parse_cloud(reader: impl BufRead, path: &Path, origin: Point3<f64>) -> Result<PointCloud> {
     let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
         line,
@@ -37,21 +37,8 @@ fn parse_cloud(mut reader: impl BufRead, path: &Path, origin: Point3<f64>) -> Re
     let mut points = Vec::new();
     let mut confidence = Vec::new();
     let mut columns = None;
-    let mut bytes = Vec::new();
-    let mut line_number = 0;
-    loop {
-        // Bytes, not `read_line`: a binary file is a parse error naming the line, not an I/O
-        // error.
-        if read_line(&mut reader, &mut bytes, path, line_number + 1)? == 0 {
-            break;
-        }
-        line_number += 1;
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|_| parse_error(line_number, "not UTF-8 text (a binary file?)".into()))?;
-        let line = text.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
+    let mut lines = ContentLines::new(reader, path);
+    while let Some((line_number, line)) = lines.next_line()? {
         let mut values = [0f64; 4];
         let mut count = 0;
         for field in line

@@ -16,7 +16,7 @@ use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
 use super::scan::ScanNode;
 use crate::error::{Error, Result};
 use crate::geometry::validate_pose;
-use crate::io::bounded::read_line;
+use crate::io::bounded::ContentLines;
 
 /// Reads an OctoMap scan log: a `NODE x y z roll pitch yaw` line starts each scan and is followed
 /// by its points, one `x y z` per line in the sensor frame. Fields are separated by whitespace;
@@ -42,28 +42,15 @@ pub fn parse_scan_log(bytes: &[u8]) -> Result<Vec<ScanNode>> {
     parse_log(bytes, Path::new("<memory>"))
 }
 
-fn parse_log(mut reader: impl BufRead, path: &Path) -> Result<Vec<ScanNode>> {
+fn parse_log(reader: impl BufRead, path: &Path) -> Result<Vec<ScanNode>> {
     let parse_error = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
         line,
         message,
     };
     let mut nodes: Vec<ScanNode> = Vec::new();
-    let mut bytes = Vec::new();
-    let mut line_number = 0;
-    loop {
-        // Bytes, not `read_line`: a binary file must be a parse error naming the line, not an
-        // I/O error.
-        if read_line(&mut reader, &mut bytes, path, line_number + 1)? == 0 {
-            break;
-        }
-        line_number += 1;
-        let text = std::str::from_utf8(&bytes)
-            .map_err(|_| parse_error(line_number, "not UTF-8 text (a binary file?)".into()))?;
-        let line = text.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
+    let mut lines = ContentLines::new(reader, path);
+    while let Some((line_number, line)) = lines.next_line()? {
         let mut fields = line.split_whitespace().peekable();
         if fields.peek() == Some(&"NODE") {
             fields.next();
