@@ -6,7 +6,7 @@
 //! Run: `cargo bench --bench pipeline`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use fuzzyvox::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, depth_from_pair};
+use fuzzyvox::depth::{DepthParams, ForwardMotion, Frame, MatchMethod, depth_from_pair};
 use fuzzyvox::sim::scenario;
 use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, VoxelMap};
 
@@ -21,14 +21,9 @@ fn frames() -> Vec<(Frame, Frame, MatchMethod)> {
     for (index, (reference, other)) in scenario.pairs.iter().enumerate() {
         let views = scenario.render_pair(index, 1).expect("pair");
         let frame = |i: usize, pose| {
-            let v = &views[i];
-            Frame::new(
-                GrayImage::new(v.width, v.height, v.image.clone()).expect("image"),
-                scenario.intrinsics,
-                pose,
-                index as f64,
-            )
-            .expect("frame")
+            views[i]
+                .to_frame(scenario.intrinsics, pose, index as f64)
+                .expect("frame")
         };
         let (a, b) = (frame(0, *reference), frame(1, *other));
         if let Ok(result) = depth_from_pair(&a, &b, &params) {

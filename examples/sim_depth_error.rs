@@ -6,7 +6,7 @@
 //! `fuzzyvox eval` does (receding pairs by plane sweep); each pixel with a depth is compared with
 //! the true depth seen from the same (rectified) camera.
 
-use fuzzyvox::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, depth_from_pair};
+use fuzzyvox::depth::{DepthParams, ForwardMotion, MatchMethod, depth_from_pair};
 use fuzzyvox::sim::{render, scenario};
 
 /// Upper ends of the true-depth bins, metres.
@@ -52,17 +52,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let Some(views) = scenario.render_pair(index, 1) else {
             continue;
         };
-        let frame = |i: usize, pose| -> fuzzyvox::Result<Frame> {
-            let v = &views[i];
-            Frame::new(
-                GrayImage::new(v.width, v.height, v.image.clone())?,
-                scenario.intrinsics,
-                pose,
-                index as f64,
-            )
-        };
-        let Ok(result) = depth_from_pair(&frame(0, *reference)?, &frame(1, *other)?, &params)
-        else {
+        let time = index as f64;
+        let (a, b) = (
+            views[0].to_frame(scenario.intrinsics, *reference, time)?,
+            views[1].to_frame(scenario.intrinsics, *other, time)?,
+        );
+        let Ok(result) = depth_from_pair(&a, &b, &params) else {
             continue;
         };
         let out = &result.frame;

@@ -11,7 +11,7 @@ use super::flights::{
 };
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
-use crate::depth::{DepthParams, ForwardMotion, Frame, GrayImage, MatchMethod, depth_from_pair};
+use crate::depth::{DepthParams, ForwardMotion, MatchMethod, depth_from_pair};
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions};
 use crate::map::{
@@ -189,17 +189,14 @@ pub fn run_experiment_with_progress(
                 continue;
             };
             render_s += t.elapsed().as_secs_f64();
-            let frame = |i: usize, pose| -> Result<Frame> {
-                let v = &views[i];
-                Frame::new(
-                    GrayImage::new(v.width, v.height, v.image.clone())?,
-                    scenario.intrinsics,
-                    pose,
-                    index as f64,
-                )
-            };
+            let [a, b] = &views;
+            let time = index as f64;
+            let (a, b) = (
+                a.to_frame(scenario.intrinsics, *reference, time)?,
+                b.to_frame(scenario.intrinsics, *other, time)?,
+            );
             let t = Instant::now();
-            let result = depth_from_pair(&frame(0, *reference)?, &frame(1, *other)?, &depth);
+            let result = depth_from_pair(&a, &b, &depth);
             depth_s += t.elapsed().as_secs_f64();
             let depth_frame: DepthFrame = match result {
                 Ok(result) => {

@@ -311,7 +311,6 @@ impl TileReach {
     }
 }
 
-/// The camera as seen from the voxel grid: everything needed to project voxel centres.
 /// The frustum as a convex solid: the camera centre and the image's four corner rays cut at
 /// the largest reach, in the camera frame. [`Pyramid::may_meet_cube`] is an exact
 /// separating-axis test against a cube (face normals of both and the cross products of their
@@ -320,9 +319,19 @@ impl TileReach {
 /// (a camera whose principal point lies far off its image), where the four side planes are
 /// nearly one plane and the per-plane tests keep a whole sheet of blocks.
 struct Pyramid {
-    /// Separating axes, each with the frustum's extent along it and the cube's half-width
-    /// along it per unit of half side.
-    axes: Vec<(Vector3<f64>, f64, f64, f64)>,
+    axes: Vec<SeparatingAxis>,
+}
+
+/// A candidate separating axis with the frustum's extent along it.
+struct SeparatingAxis {
+    /// Unit direction, in the camera frame.
+    direction: Vector3<f64>,
+    /// The frustum's lowest and highest projection on it.
+    low: f64,
+    high: f64,
+    /// A cube's half extent along it per unit of its half side: the sum of `|direction · e|`
+    /// over the cube's edge directions `e`.
+    spread: f64,
 }
 
 impl Pyramid {
@@ -365,8 +374,14 @@ impl Pyramid {
                 let spread: f64 = cube.iter().map(|a| axis.dot(a).abs()).sum();
                 // An axis whose extent overflowed separates nothing reliably: leave it out, so
                 // the test stays conservative.
-                (low.is_finite() && high.is_finite() && spread.is_finite())
-                    .then_some((axis, low, high, spread))
+                (low.is_finite() && high.is_finite() && spread.is_finite()).then_some(
+                    SeparatingAxis {
+                        direction: axis,
+                        low,
+                        high,
+                        spread,
+                    },
+                )
             })
             .collect();
         Self { axes }
@@ -377,15 +392,16 @@ impl Pyramid {
     /// margin.
     fn may_meet_cube(&self, view: &CameraView, corner: Point3<f64>, side: f64) -> bool {
         let center = view.to_camera(&(corner + Vector3::repeat(0.5 * side)));
-        self.axes.iter().all(|(axis, low, high, spread)| {
-            let at = axis.dot(&center);
-            let half = 0.5 * side * spread;
-            let margin = 1e-9 * (at.abs() + half + low.abs() + high.abs()) + 1e-9;
-            at - half <= high + margin && at + half >= low - margin
+        self.axes.iter().all(|axis| {
+            let at = axis.direction.dot(&center);
+            let half = 0.5 * side * axis.spread;
+            let margin = 1e-9 * (at.abs() + half + axis.low.abs() + axis.high.abs()) + 1e-9;
+            at - half <= axis.high + margin && at + half >= axis.low - margin
         })
     }
 }
 
+/// The camera as seen from the voxel grid: everything needed to project voxel centres.
 struct CameraView {
     camera_from_world: Matrix3<f64>,
     camera_in_world: Vector3<f64>,

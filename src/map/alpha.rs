@@ -124,6 +124,7 @@ impl VoxelMap for AlphaCutMap {
         // an end point in it; cut k's scan is then the voxels of level k and up (the same sets
         // as inserting the points of cut k and up as their own scan), applied in order.
         let resolution = self.inner.resolution();
+        // At most `cuts` (validated to 1..=1000) levels, so the conversion never saturates.
         let (levels, mut stats) = scan_levels(cloud, &resolution, options, |i| {
             u16::try_from(self.config.cuts_of(cloud.confidence_of(i))).unwrap_or(u16::MAX)
         })?;

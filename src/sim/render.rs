@@ -3,6 +3,8 @@ use rayon::prelude::*;
 
 use super::scene::Scene;
 use super::texture::{albedo, unit_hash};
+use crate::depth::{Frame, GrayImage};
+use crate::error::Result;
 use crate::geometry::PinholeIntrinsics;
 
 /// A rendered view: a grayscale image in `[0, 1]` and the true depth along the optical axis
@@ -17,6 +19,20 @@ pub struct RenderedFrame {
     pub image: Vec<f32>,
     /// True depth (metres along the optical axis) per pixel, NaN for sky.
     pub depth: Vec<f32>,
+}
+
+impl RenderedFrame {
+    /// The rendered image as the depth stage's input: a frame taken by `intrinsics` (those it
+    /// was rendered with) at `world_from_camera` and `timestamp`.
+    pub fn to_frame(
+        &self,
+        intrinsics: PinholeIntrinsics,
+        world_from_camera: Isometry3<f64>,
+        timestamp: f64,
+    ) -> Result<Frame> {
+        let image = GrayImage::new(self.width, self.height, self.image.clone())?;
+        Frame::new(image, intrinsics, world_from_camera, timestamp)
+    }
 }
 
 /// Direction of the sun for shading (unit, pointing towards the sun): high, from behind the
