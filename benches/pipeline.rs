@@ -1,22 +1,21 @@
 //! One stereo pair through the whole pipeline at 320 × 240: the depth stage (rectification,
 //! matching, intervals and confidence) and fuzzy frustum integration, on pairs of the
 //! simulator's random flight. Criterion reports time per pair; pairs per second = 1 / time.
-//! The rendering of the views is outside the measured loop.
+//! The rendering of the views is outside the measured loop. `multi_view` is one depth image
+//! from five views (a pair and its three earlier positions, `fuzzyvox eval --views 5`).
 //!
 //! Run: `cargo bench --bench pipeline`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use fuzzyvox::depth::{DepthParams, ForwardMotion, Frame, MatchMethod, depth_from_pair};
+use fuzzyvox::depth::{
+    DepthParams, ForwardMotion, Frame, MatchMethod, depth_from_pair, depth_from_views,
+};
 use fuzzyvox::sim::scenario;
 use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, VoxelMap};
 
-fn frames() -> Vec<(Frame, Frame, MatchMethod)> {
+/// Every pair of a 40-pair random flight, its views and how the depth stage matches it.
+fn frames(params: &DepthParams) -> Vec<(Frame, Frame, Option<MatchMethod>)> {
     let scenario = scenario::random(40, 1).expect("scenario");
-    let params = DepthParams {
-        depth_range: Some((1.0, scenario.max_range)),
-        forward_motion: ForwardMotion::PlaneSweep,
-        ..DepthParams::default()
-    };
     let mut pairs = Vec::new();
     for (index, (reference, other)) in scenario.pairs.iter().enumerate() {
         let views = scenario.render_pair(index, 1).expect("pair");
@@ -26,11 +25,28 @@ fn frames() -> Vec<(Frame, Frame, MatchMethod)> {
                 .expect("frame")
         };
         let (a, b) = (frame(0, *reference), frame(1, *other));
-        if let Ok(result) = depth_from_pair(&a, &b, &params) {
-            pairs.push((a, b, result.method));
-        }
+        let method = depth_from_pair(&a, &b, params).ok().map(|r| r.method);
+        pairs.push((a, b, method));
     }
     pairs
+}
+
+/// Five views per depth image as `eval --views 5` picks them: pair `k`'s two views (positions
+/// `k + 1` and `k`) and the reference views of pairs `k - 2 .. k - 4` (positions `k - 1 .. k - 3`).
+fn view_sets(
+    pairs: &[(Frame, Frame, Option<MatchMethod>)],
+    params: &DepthParams,
+) -> Vec<(usize, [usize; 3])> {
+    (4..pairs.len())
+        .map(|k| (k, [k - 2, k - 3, k - 4]))
+        .filter(|(k, earlier)| {
+            let others: Vec<&Frame> = std::iter::once(&pairs[*k].1)
+                .chain(earlier.iter().map(|&j| &pairs[j].0))
+                .collect();
+            depth_from_views(&pairs[*k].0, &others, params).is_ok()
+        })
+        .take(8)
+        .collect()
 }
 
 fn pipeline(c: &mut Criterion) {
@@ -43,17 +59,23 @@ fn pipeline(c: &mut Criterion) {
     let options = IntegrationOptions {
         max_range: Some(scenario.max_range),
     };
-    let pairs = frames();
+    let pairs = frames(&params);
     let mut group = c.benchmark_group("pair_320x240");
     group.sample_size(10);
     for method in [MatchMethod::Rectified, MatchMethod::PlaneSweep] {
-        let chosen: Vec<_> = pairs.iter().filter(|p| p.2 == method).take(8).collect();
+        // Each pair on its own.
+        let chosen: Vec<_> = pairs
+            .iter()
+            .filter(|p| p.2 == Some(method))
+            .take(8)
+            .collect();
         if chosen.is_empty() {
             continue;
         }
         let name = match method {
             MatchMethod::Rectified => "rectified",
             MatchMethod::PlaneSweep => "plane_sweep",
+            MatchMethod::MultiView => "multi_view",
         };
         group.bench_function(format!("{name}_depth_and_fuzzy_integration"), |b| {
             let mut i = 0;
@@ -66,6 +88,21 @@ fn pipeline(c: &mut Criterion) {
             })
         });
     }
+    let sets = view_sets(&pairs, &params);
+    assert!(!sets.is_empty(), "no five-view set fits the plane sweep");
+    group.bench_function("multi_view_5_depth_and_fuzzy_integration", |b| {
+        let mut i = 0;
+        let mut map = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap();
+        b.iter(|| {
+            let (k, earlier) = &sets[i % sets.len()];
+            i += 1;
+            let others: Vec<&Frame> = std::iter::once(&pairs[*k].1)
+                .chain(earlier.iter().map(|&j| &pairs[j].0))
+                .collect();
+            let result = depth_from_views(&pairs[*k].0, &others, &params).unwrap();
+            map.integrate_depth(&result.frame, &options).unwrap()
+        })
+    });
     group.finish();
 }
 

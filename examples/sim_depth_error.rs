@@ -1,12 +1,13 @@
 //! How far the depth stage's output lies from the simulator's true depth, by range and by pair
 //! quality: the measurement behind the random-flight figures in `docs/experiments.md`.
 //!
-//! Run: `cargo run --release --example sim_depth_error -- [random|wall] [PAIRS] [VOXEL]`,
-//! e.g. `-- random 100 0.2` (the defaults). Every pair is rendered and matched as
-//! `fuzzyvox eval` does (receding pairs by plane sweep); each pixel with a depth is compared with
-//! the true depth seen from the same (rectified) camera.
+//! Run: `cargo run --release --example sim_depth_error -- [random|wall] [PAIRS] [VOXEL] [VIEWS]`,
+//! e.g. `-- random 100 0.2 2` (the defaults). Every pair is rendered and matched as
+//! `fuzzyvox eval --views VIEWS` does (receding pairs by plane sweep; more than two views by the
+//! multiple-baseline sweep); each pixel with a depth is compared with the true depth seen from
+//! the same (rectified) camera, by true depth and by surface (the ground or anything else).
 
-use fuzzyvox::depth::{DepthParams, ForwardMotion, MatchMethod, depth_from_pair};
+use fuzzyvox::depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
 use fuzzyvox::sim::{render, scenario};
 
 /// Upper ends of the true-depth bins, metres.
@@ -31,6 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = args.next().unwrap_or_else(|| "random".into());
     let pairs: usize = args.next().map_or(Ok(100), |s| s.parse())?;
     let voxel: f32 = args.next().map_or(Ok(0.2), |s| s.parse())?;
+    let mut window = ViewWindow::new(args.next().map_or(Ok(2), |s| s.parse())?)?;
     let scenario = match name.as_str() {
         "wall" => scenario::wall()?,
         "random" => scenario::random(pairs, 1)?,
@@ -48,7 +50,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut depth_in_sky = 0usize;
     // Per rectified pair: its Q_ABD and the median |disparity error| over its pixels.
     let mut by_quality: Vec<(f64, f32)> = Vec::new();
+    // |P0 - truth| on the ground (world z below 0.1 m) and on everything else.
+    let (mut ground, mut other_surfaces) = (Vec::new(), Vec::new());
     for (index, (reference, other)) in scenario.pairs.iter().enumerate() {
+        if scenario.phases.iter().any(|(_, r)| r.start == index) {
+            window.clear();
+        }
         let Some(views) = scenario.render_pair(index, 1) else {
             continue;
         };
@@ -57,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             views[0].to_frame(scenario.intrinsics, *reference, time)?,
             views[1].to_frame(scenario.intrinsics, *other, time)?,
         );
-        let Ok(result) = depth_from_pair(&a, &b, &params) else {
+        let Ok(result) = window.depth(a, b, &params) else {
             continue;
         };
         let out = &result.frame;
@@ -91,6 +98,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 b.width += f64::from(far - near);
             }
             b.confidence += f64::from(image.confidence()[i]);
+            let (u, v) = (i % truth.width as usize, i / truth.width as usize);
+            let seen = out
+                .intrinsics()
+                .back_project(u as f64, v as f64, f64::from(true_z));
+            let error = (z - true_z).abs();
+            if (out.world_from_camera() * seen).z < 0.1 {
+                ground.push(error);
+            } else {
+                other_surfaces.push(error);
+            }
             if rectified {
                 let d = result.disparity.disparity[i];
                 let true_d = result.geometry.disparity(f64::from(true_z)) as f32;
@@ -103,8 +120,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
 
     println!(
-        "{name}, {} pairs, voxel {voxel} m; pixels with a depth where the truth is sky: {depth_in_sky}",
-        scenario.pairs.len()
+        "{name}, {} pairs, {} views, voxel {voxel} m; pixels with a depth where the truth is sky: {depth_in_sky}",
+        scenario.pairs.len(),
+        window.views()
     );
     println!(
         "| true depth | pixels | |P0 - truth| > voxel | truth outside [P-, P+] | mean width | mean confidence |"
@@ -124,6 +142,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
         start = *end;
+    }
+    println!("\n| surface | pixels | |P0 - truth| > voxel | median |P0 - truth| |");
+    println!("|---|---|---|---|");
+    for (surface, errors) in [("ground", &mut ground), ("other", &mut other_surfaces)] {
+        if !errors.is_empty() {
+            let beyond = errors.iter().filter(|e| **e > voxel).count();
+            println!(
+                "| {surface} | {} | {:.1} % | {:.3} m |",
+                errors.len(),
+                100.0 * beyond as f64 / errors.len() as f64,
+                median(errors)
+            );
+        }
     }
     println!("\n| pair Q_ABD | rectified pairs | median of their median |disparity error| |");
     println!("|---|---|---|");

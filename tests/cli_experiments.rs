@@ -88,6 +88,10 @@ fn eval_refuses_bad_arguments() {
         "resolution",
     );
     fails_with(&fuzzyvox(&["eval", "--scenario", "moon"]), "moon");
+    fails_with(
+        &fuzzyvox(&["eval", "--scenario", "wall", "--views", "18"]),
+        "--views",
+    );
 }
 
 #[test]

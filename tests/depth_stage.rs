@@ -6,7 +6,7 @@ mod common;
 use fuzzyvox::depth::{
     DepthParams, ForwardMotion, Frame, GrayImage, IntervalMethod, MatchMethod, MatchParams,
     PairCriteria, PairSelector, Rectification, Side, UnrectifiableReason, depth_by_plane_sweep,
-    depth_from_pair, match_pair,
+    depth_from_pair, depth_from_views, match_pair,
 };
 use fuzzyvox::io::pfm::read_pfm;
 use fuzzyvox::{
@@ -142,6 +142,118 @@ fn forward_motion_is_matched_by_plane_sweep_with_honest_intervals() {
     params.depth_range = None;
     assert!(matches!(
         depth_by_plane_sweep(&reference, &sideways, 1.0, &params),
+        Err(Error::InvalidParameter { .. })
+    ));
+}
+
+/// Median `|P0 - truth|` and median interval width over the pixels with a bounded interval,
+/// and the share of those whose interval holds the true depth, for a depth frame in the
+/// camera `pose` looking at the textured plane.
+fn depth_errors(image: &fuzzyvox::IntervalDepthImage, pose: &Isometry3<f64>) -> (f32, f32, f64) {
+    let k = camera();
+    let origin = Point3::from(pose.translation.vector);
+    let (mut errors, mut widths, mut inside) = (Vec::new(), Vec::new(), 0usize);
+    for i in 0..image.depth().len() {
+        let (near, depth, far) = (image.near()[i], image.depth()[i], image.far()[i]);
+        if !(depth.is_finite() && far.is_finite()) {
+            continue;
+        }
+        let (u, v) = ((i % 320) as f64, (i / 320) as f64);
+        let ray = pose.rotation * k.back_project(u, v, 1.0).coords;
+        let truth = (pose.inverse() * plane_hit(&origin, &ray).unwrap()).z as f32;
+        errors.push((depth - truth).abs());
+        widths.push(far - near);
+        inside += usize::from(near <= truth && truth <= far);
+    }
+    assert!(errors.len() > 320 * 240 / 2, "{} pixels", errors.len());
+    let share = inside as f64 / errors.len() as f64;
+    let median = |v: &mut Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v[v.len() / 2]
+    };
+    (median(&mut errors), median(&mut widths), share)
+}
+
+#[test]
+fn several_views_sharpen_depth_beyond_one_pair() {
+    let k = camera();
+    // Four cameras 10 cm apart along a line, looking at the plane 4 m away: the reference and
+    // three earlier views with baselines of 0.1, 0.2 and 0.3 m.
+    let reference_pose = pose([0.3, 0.0, 0.0], 0.0);
+    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 3.0).unwrap();
+    let others: Vec<Frame> = (0..3)
+        .map(|i| {
+            let p = pose([0.2 - 0.1 * f64::from(i), 0.0, 0.0], 0.0);
+            Frame::new(render(&k, &p), k, p, 2.0 - f64::from(i)).unwrap()
+        })
+        .collect();
+    let params = DepthParams {
+        depth_range: Some((2.0, 12.0)),
+        ..DepthParams::default()
+    };
+    let pair = depth_by_plane_sweep(&reference, &others[0], 1.0, &params).unwrap();
+    let views: Vec<&Frame> = others.iter().collect();
+    let multi = depth_from_views(&reference, &views, &params).unwrap();
+    assert_eq!(multi.method, MatchMethod::MultiView);
+    assert_eq!(multi.frame.world_from_camera(), &reference_pose);
+    assert!(multi.quality > 0.99, "Q_ABD {}", multi.quality);
+    let (pair_error, pair_width, pair_inside) = depth_errors(pair.frame.image(), &reference_pose);
+    let (multi_error, multi_width, multi_inside) =
+        depth_errors(multi.frame.image(), &reference_pose);
+    // Three times the baseline: the planes are three times finer, and so are the intervals.
+    assert!(
+        multi_error * 2.0 < pair_error,
+        "median error {multi_error} m with four views, {pair_error} m with one pair"
+    );
+    assert!(
+        multi_width * 2.0 < pair_width,
+        "median width {multi_width} m, {pair_width} m"
+    );
+    assert!(
+        pair_inside > 0.9 && multi_inside > 0.9,
+        "{pair_inside} {multi_inside}"
+    );
+    // One other view is the two-view sweep.
+    let single = depth_from_views(&reference, &views[..1], &params).unwrap();
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        bits(&single.disparity.disparity),
+        bits(&pair.disparity.disparity)
+    );
+    assert_eq!(
+        bits(&single.disparity.range_high),
+        bits(&pair.disparity.range_high)
+    );
+    // The same views in another order give the same depth.
+    let reversed: Vec<&Frame> = others.iter().rev().collect();
+    let again = depth_from_views(&reference, &reversed, &params).unwrap();
+    assert_eq!(
+        bits(again.frame.image().depth()),
+        bits(multi.frame.image().depth())
+    );
+
+    // No view, too many views, a view without baseline, no depth range: typed errors.
+    assert!(matches!(
+        depth_from_views(&reference, &[], &params),
+        Err(Error::Empty(_))
+    ));
+    let crowd = vec![&others[0]; fuzzyvox::depth::MAX_SWEEP_VIEWS + 1];
+    assert!(matches!(
+        depth_from_views(&reference, &crowd, &params),
+        Err(Error::InvalidParameter { .. })
+    ));
+    assert!(matches!(
+        depth_from_views(&reference, &[&others[0], &reference], &params),
+        Err(Error::Unrectifiable {
+            reason: UnrectifiableReason::ZeroBaseline { .. }
+        })
+    ));
+    let unbounded = DepthParams {
+        depth_range: None,
+        ..params.clone()
+    };
+    assert!(matches!(
+        depth_from_views(&reference, &views, &unbounded),
         Err(Error::InvalidParameter { .. })
     ));
 }

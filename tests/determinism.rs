@@ -3,7 +3,9 @@
 //! and the maps built from it. (Map integration alone is covered for every map kind in
 //! `baselines.rs` and `fuzzy_map.rs`.)
 
-use fuzzyvox::depth::{DepthParams, DepthResult, Frame, GrayImage, depth_from_pair};
+use fuzzyvox::depth::{
+    DepthParams, DepthResult, Frame, GrayImage, depth_from_pair, depth_from_views,
+};
 use fuzzyvox::sim::render;
 use fuzzyvox::sim::scenario;
 use fuzzyvox::{
@@ -125,5 +127,45 @@ fn depth_from_pair_is_identical_for_1_2_and_8_threads() {
     assert!(bytes.iter().all(|b| b.len() > 10_000));
     for threads in [2, 8] {
         assert_eq!(build(threads), bytes, "maps with {threads} threads");
+    }
+}
+
+#[test]
+fn depth_from_views_is_identical_for_1_2_and_8_threads() {
+    // The wall's first three strafing pairs: a reference and five earlier positions.
+    let wall = scenario::wall().unwrap();
+    let frame = |pose, side: u64| {
+        let view = render(&wall.scene, &wall.intrinsics, &pose, 50 + side, 160.0);
+        let image = GrayImage::new(view.width, view.height, view.image).unwrap();
+        Frame::new(image, wall.intrinsics, pose, side as f64).unwrap()
+    };
+    let (reference, _) = wall.pairs[2];
+    let reference = frame(reference, 0);
+    let others: Vec<Frame> = [(2, false), (1, true), (1, false), (0, true), (0, false)]
+        .into_iter()
+        .enumerate()
+        .map(|(side, (index, first))| {
+            let (a, b) = wall.pairs[index];
+            frame(if first { a } else { b }, side as u64 + 1)
+        })
+        .collect();
+    let others: Vec<&Frame> = others.iter().collect();
+    let params = DepthParams {
+        depth_range: Some((4.0, wall.max_range)),
+        ..DepthParams::default()
+    };
+    let run = |threads: usize| {
+        in_pool(threads, || {
+            fingerprint(&depth_from_views(&reference, &others, &params).unwrap())
+        })
+    };
+    let one = run(1);
+    let valid = one[1]
+        .iter()
+        .filter(|d| f32::from_bits(**d as u32).is_finite())
+        .count();
+    assert!(valid > 10_000, "only {valid} pixels with a depth");
+    for threads in [2, 8] {
+        assert_eq!(run(threads), one, "{threads} threads");
     }
 }

@@ -89,3 +89,47 @@ fn the_wall_experiment_is_reproducible_and_reports_every_map() {
     assert!(5 * fuzzy.holes <= standard.metrics.holes);
     assert!(5 * fuzzy.spurious_unknown <= standard.metrics.spurious_unknown);
 }
+
+#[test]
+fn the_wall_experiment_with_several_views_per_depth_image() {
+    use fuzzyvox::eval::{ExperimentConfig, run_experiment};
+    use fuzzyvox::sim::scenario;
+    let scenario = scenario::wall().unwrap();
+    let run = |views: usize| {
+        let config = ExperimentConfig {
+            resolution: 0.25,
+            views,
+            ..ExperimentConfig::default()
+        };
+        run_experiment(&scenario, &config).unwrap().report
+    };
+    let (pairs, several) = (run(2), run(4));
+    assert_eq!((pairs.views, several.views), (2, 4));
+    // Every pair but the first strafing one goes through the plane sweep (the first of each
+    // phase has no earlier view; the first receding pair is swept anyway), nothing refused.
+    assert_eq!(several.swept_pairs, 11);
+    assert_eq!(several.rejected_pairs, 0);
+    // The receding pairs' earlier positions lie ahead along the view, 1.0 and 1.4 m: depths
+    // from 1 m would sweep points through those cameras' own planes (more than 1024 planes),
+    // so both are left out of each of the five later receding pairs.
+    assert_eq!(several.views_dropped, 10);
+    // Baselines up to 1.4 m instead of 0.4 m: the standard map puts fewer voxels behind the
+    // wall and in the sky after the strafe phase.
+    let spurious = |report: &fuzzyvox::eval::ExperimentReport| {
+        report.maps["logodds"].after["after_strafe"].spurious_unknown
+    };
+    assert!(
+        2 * spurious(&several) < spurious(&pairs),
+        "{} with four views, {} with pairs",
+        spurious(&several),
+        spurious(&pairs)
+    );
+    let config = ExperimentConfig {
+        views: 1,
+        ..ExperimentConfig::default()
+    };
+    assert!(matches!(
+        run_experiment(&scenario, &config),
+        Err(fuzzyvox::Error::InvalidParameter { name: "views", .. })
+    ));
+}

@@ -37,6 +37,11 @@ pub struct EvalArgs {
     /// Voxel size in metres.
     #[arg(long, default_value_t = 0.2)]
     res: f64,
+    /// Camera views behind each depth image: 2 matches every stereo pair on its own (the
+    /// paper's depth stage); N > 2 adds the N - 2 most recent earlier camera positions of the
+    /// same phase and matches them at once (multiple-baseline plane sweep).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=17))]
+    views: u32,
     /// Plan this many random flights in every map and check them against the true scene.
     #[arg(long, default_value_t = 0)]
     plan: usize,
@@ -135,7 +140,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         .map(|op| op.parse::<Family>().with_context(|| format!("--ops {op}")))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let scenario = args.scenario.build(args.pairs, args.seed)?;
-    let config = experiment_config(
+    let mut config = experiment_config(
         &scenario,
         args.res,
         operators,
@@ -143,6 +148,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         args.plan,
         args.unknown.policy(args.unknown_cost),
     );
+    config.views = args.views as usize;
     let started = Instant::now();
     let output = run_with_bar(&scenario, &config, args.json)?;
     let seconds = started.elapsed().as_secs_f64();
@@ -162,8 +168,16 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     if args.json {
         return super::print_json(&serde_json::to_value(report)?);
     }
+    let views = if report.views > 2 {
+        format!(
+            ", up to {} views per depth image ({} earlier views left out)",
+            report.views, report.views_dropped
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "{} scenario: {} pairs ({} by plane sweep, {} rejected) in {seconds:.1} s; {} truly occupied voxels",
+        "{} scenario: {} pairs ({} by plane sweep, {} rejected{views}) in {seconds:.1} s; {} truly occupied voxels",
         report.scenario,
         report.pairs,
         report.swept_pairs,

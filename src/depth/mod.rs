@@ -1,7 +1,8 @@
 //! The depth stage (EpiDepth-style motion stereo with one camera): pair selection, extrinsic
 //! quality `Q_ABD`, rectification, census block matching, and per-pixel depth intervals
 //! `P- <= P0 <= P+` with a confidence, output as a [`DepthFrame`](crate::DepthFrame) for the
-//! frustum integrator. See `docs/depth.md`.
+//! frustum integrator; and depth from several views at once ([`depth_from_views`],
+//! [`ViewWindow`]). See `docs/depth.md`.
 
 mod census;
 mod frame;
@@ -15,6 +16,7 @@ mod quality;
 mod rectify;
 mod scan;
 mod sweep;
+mod views;
 
 pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
@@ -28,7 +30,9 @@ pub use metrics::{Accuracy, evaluate};
 pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
 pub use pipeline::{
     DepthParams, DepthResult, ForwardMotion, MatchMethod, depth_by_plane_sweep, depth_from_pair,
-    depth_from_rectified, depth_from_selected,
+    depth_from_rectified, depth_from_selected, depth_from_views,
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
 pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry, UnrectifiableReason};
+pub use sweep::{MAX_SWEEP_VIEWS, PLANE_COUNT};
+pub use views::ViewWindow;

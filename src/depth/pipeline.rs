@@ -10,7 +10,7 @@ use super::matching::match_pair;
 use super::params::{DisparityMap, MatchParams};
 use super::quality::extrinsic_quality;
 use super::rectify::{Rectification, Side, StereoGeometry, UnrectifiableReason};
-use super::sweep::{Sweep, sweep_pair};
+use super::sweep::{Sweep, sweep_views};
 use crate::error::{Error, Result};
 use crate::integrate::DepthFrame;
 
@@ -49,6 +49,9 @@ pub enum MatchMethod {
     Rectified,
     /// Plane sweep in the original reference camera.
     PlaneSweep,
+    /// Plane sweep in the original reference camera against several other views at once
+    /// ([`depth_from_views`]).
+    MultiView,
 }
 
 /// The depth stage's output for one pair.
@@ -62,8 +65,10 @@ pub struct DepthResult {
     pub geometry: StereoGeometry,
     /// How the pair was matched.
     pub method: MatchMethod,
-    /// The pair's `Q_ABD`.
+    /// The pair's `Q_ABD` (several views: the best between the reference and any of them).
     pub quality: f64,
+    /// Camera views matched, the reference included: 2 for a pair.
+    pub views: usize,
     /// Wall time of the matching step (census, costs, aggregation, checks), in seconds.
     pub matching_seconds: f64,
 }
@@ -93,6 +98,7 @@ pub fn depth_from_rectified(
         params,
         matching_seconds,
         MatchMethod::Rectified,
+        2,
     )
 }
 
@@ -104,6 +110,7 @@ fn finish(
     params: &DepthParams,
     matching_seconds: f64,
     method: MatchMethod,
+    views: usize,
 ) -> Result<DepthResult> {
     let image = interval_image(&disparity, geometry, &params.interval, quality)?;
     let frame = DepthFrame::new(
@@ -117,6 +124,7 @@ fn finish(
         geometry: geometry.clone(),
         method,
         quality,
+        views,
         matching_seconds,
     })
 }
@@ -161,6 +169,45 @@ pub fn depth_by_plane_sweep(
     quality: f64,
     params: &DepthParams,
 ) -> Result<DepthResult> {
+    sweep(
+        reference,
+        &[other],
+        quality,
+        params,
+        MatchMethod::PlaneSweep,
+    )
+}
+
+/// Depth in `reference`'s own camera from several other views at once: a multiple-baseline
+/// plane sweep (see `docs/depth.md`). Each plane's cost is the mean census distance over the
+/// views a pixel lands in; the longest baseline sets the plane step, so depth is as fine as that
+/// baseline allows while the shorter ones keep the match unambiguous. The confidence carries the
+/// best `Q_ABD` between the reference and any of the views. `params.depth_range` is required.
+///
+/// Errors: no other view or more than [`MAX_SWEEP_VIEWS`](super::MAX_SWEEP_VIEWS), invalid
+/// poses, a view at the reference's position, a depth range that needs more than 1024 planes
+/// for the longest baseline, invalid parameters.
+pub fn depth_from_views(
+    reference: &Frame,
+    others: &[&Frame],
+    params: &DepthParams,
+) -> Result<DepthResult> {
+    let mut quality: f64 = 0.0;
+    for other in others {
+        let q = extrinsic_quality(reference.world_from_camera(), other.world_from_camera())?;
+        quality = quality.max(q.q);
+    }
+    sweep(reference, others, quality, params, MatchMethod::MultiView)
+}
+
+/// The plane sweep behind [`depth_by_plane_sweep`] and [`depth_from_views`].
+fn sweep(
+    reference: &Frame,
+    others: &[&Frame],
+    quality: f64,
+    params: &DepthParams,
+    method: MatchMethod,
+) -> Result<DepthResult> {
     params.interval.validate()?;
     let Some((near, far)) = params.depth_range else {
         return Err(Error::InvalidParameter {
@@ -169,10 +216,10 @@ pub fn depth_by_plane_sweep(
             expected: "a depth range (near, far) for the plane sweep",
         });
     };
-    let sweep = Sweep::new(reference, other, near, far)?;
+    let sweep = Sweep::new(reference, others, near, far)?;
     let geometry = sweep.geometry(reference)?;
     let start = Instant::now();
-    let disparity = sweep_pair(reference, other, &sweep, &params.matching)?;
+    let disparity = sweep_views(reference, others, &sweep, &params.matching)?;
     let matching_seconds = start.elapsed().as_secs_f64();
     finish(
         disparity,
@@ -180,7 +227,8 @@ pub fn depth_by_plane_sweep(
         quality,
         params,
         matching_seconds,
-        MatchMethod::PlaneSweep,
+        method,
+        1 + others.len(),
     )
 }
 

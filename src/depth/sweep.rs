@@ -1,16 +1,21 @@
-//! Plane-sweep matching in the original reference camera, for pairs that cannot be rectified
-//! usefully (motion along the look direction puts the epipole inside the image).
+//! Plane-sweep matching in the original reference camera: for pairs that cannot be rectified
+//! usefully (motion along the look direction puts the epipole inside the image), and for
+//! several other views at once (multi-baseline stereo).
 //!
 //! Fronto-parallel planes at inverse depths `w_k = w_far + k · Δw` (`k = 0 .. K`) play the part
 //! of disparities: a reference pixel `x` on plane `k` maps into the other image at
 //! `π(M x̃ + w_k K_o t)`, where `M = K_o R K_r⁻¹` and `(R, t)` is `other_from_reference`. `Δw` is
 //! chosen so that no pixel moves more than one pixel between neighbouring planes. Each plane's
 //! cost is the census Hamming distance to the other image's nearest pixel, aggregated over the
-//! same window as the row matcher; winner-takes-all with a parabola refinement, the uniqueness
-//! test and the cost-curve range follow, exactly as for rectified pairs. Because `w` is affine
-//! in the plane index, depth is `1 / (w_far + k Δw)`, which is a [`StereoGeometry`] with
-//! `baseline · f = 1 / Δw` and `doffs = w_far / Δw`: the interval and confidence code of
-//! rectified pairs applies unchanged.
+//! same window as the row matcher. With several other views (Okutomi and Kanade's
+//! multiple-baseline stereo) a pixel's cost on a plane is the mean distance over the views it
+//! lands in, and the view that moves fastest (the longest baseline) sets `Δw`: the short
+//! baselines keep the cost curve free of repeated minima, the long one makes it sharp, and one
+//! plane step is one pixel of the longest baseline. Then winner-takes-all with a parabola
+//! refinement, the uniqueness test and the cost-curve range follow, exactly as for rectified
+//! pairs. Because `w` is affine in the plane index, depth is `1 / (w_far + k Δw)`, which is a
+//! [`StereoGeometry`] with `baseline · f = 1 / Δw` and `doffs = w_far / Δw`: the interval and
+//! confidence code of rectified pairs applies unchanged.
 //!
 //! Near the epipole the planes barely move a pixel, the cost curve is flat and the uniqueness
 //! test drops the pixel, or its cost-curve interval is wide and its confidence low: the honest
@@ -33,13 +38,32 @@ use crate::error::{Error, Result};
 /// Rows per band of the sweep (plus a halo of half a window above and below).
 const BAND_ROWS: usize = 32;
 
-/// The planes of a sweep and the geometry that turns a plane index into depth.
+/// Raw costs are the mean census distance over the views that see a pixel, in units of an
+/// eighth of a bit, so that a mean over several views keeps three bits of its fraction. The
+/// largest raw cost, `31 · 8 = 248`, still fits a byte and a 15 × 15 window sum a `u16`.
+const COST_SCALE: u32 = 8;
+
+/// The parameter an [`Error::InvalidParameter`] names when a sweep would need more than
+/// [`MAX_DISPARITIES`] planes.
+pub const PLANE_COUNT: &str = "plane count for the depth range";
+
+/// Most other views one sweep matches against (a pixel's cost sums and counts stay small).
+pub const MAX_SWEEP_VIEWS: usize = 16;
+
+/// One other view of a sweep: where a reference pixel lands in it on each plane.
 #[derive(Clone, Debug)]
-pub(crate) struct Sweep {
+struct SweepView {
     /// `K_o R K_r⁻¹`, in single precision.
     homography: [[f32; 3]; 3],
     /// `K_o t`.
     translation: [f32; 3],
+}
+
+/// The planes of a sweep and the geometry that turns a plane index into depth.
+#[derive(Clone, Debug)]
+pub(crate) struct Sweep {
+    /// The other views, in the order given.
+    views: Vec<SweepView>,
     /// Inverse depth of plane 0 (the farthest).
     inverse_far: f64,
     /// Inverse-depth step between planes.
@@ -49,8 +73,10 @@ pub(crate) struct Sweep {
 }
 
 impl Sweep {
-    /// The planes covering depths `near ..= far` for this pair.
-    pub(crate) fn new(reference: &Frame, other: &Frame, near: f64, far: f64) -> Result<Self> {
+    /// The planes covering depths `near ..= far` for `reference` seen from every view of
+    /// `others`: the step is set by the view whose image moves fastest (the longest baseline),
+    /// so that no pixel of any view moves more than one pixel between neighbouring planes.
+    pub(crate) fn new(reference: &Frame, others: &[&Frame], near: f64, far: f64) -> Result<Self> {
         if !(near.is_finite() && near > 0.0 && far > near) {
             return Err(Error::InvalidParameter {
                 name: "depth range",
@@ -58,6 +84,141 @@ impl Sweep {
                 expected: "0 < near < far",
             });
         }
+        if others.is_empty() {
+            return Err(Error::Empty("other views of the plane sweep"));
+        }
+        if others.len() > MAX_SWEEP_VIEWS {
+            return Err(Error::InvalidParameter {
+                name: "other views of the plane sweep",
+                value: others.len() as f64,
+                expected: "1 to 16 other views",
+            });
+        }
+        let (inverse_near, inverse_far) =
+            (1.0 / near, if far.is_finite() { 1.0 / far } else { 0.0 });
+        let mut rate: f64 = 0.0;
+        let mut views = Vec::with_capacity(others.len());
+        for other in others {
+            let (view, view_rate) = SweepView::new(reference, other, inverse_near, inverse_far)?;
+            rate = rate.max(view_rate);
+            views.push(view);
+        }
+        let planes = (rate * (inverse_near - inverse_far)).ceil() + 1.0;
+        if !(planes.is_finite() && planes <= f64::from(MAX_DISPARITIES)) {
+            return Err(Error::InvalidParameter {
+                name: PLANE_COUNT,
+                value: planes,
+                expected: "1 to 1024 planes (narrow the depth range or the baselines)",
+            });
+        }
+        let planes = planes.max(2.0) as u32;
+        let step = (inverse_near - inverse_far) / f64::from(planes - 1);
+        Ok(Self {
+            views,
+            inverse_far,
+            step,
+            planes,
+        })
+    }
+
+    /// The geometry that maps a (fractional) plane index to depth in the reference camera.
+    pub(crate) fn geometry(&self, reference: &Frame) -> Result<StereoGeometry> {
+        let fx = reference.intrinsics().fx();
+        StereoGeometry::new(
+            *reference.intrinsics(),
+            *reference.world_from_camera(),
+            1.0 / (self.step * fx),
+            self.inverse_far / self.step,
+        )
+    }
+
+    /// Raw costs of reference row `y` on plane `k`, written into `out` (one per column): the
+    /// mean census distance over the views in which the pixel lands on a valid pixel, scaled by
+    /// [`COST_SCALE`], or the largest cost where it lands in none. `sums` and `landing` are
+    /// scratch space of the row's width.
+    #[allow(clippy::too_many_arguments)]
+    fn row_costs(
+        &self,
+        y: usize,
+        rays: RowRays<'_>,
+        k: u32,
+        reference: &CensusImage,
+        others: &[CensusImage],
+        sums: &mut [(u16, u8)],
+        landing: &mut [u32],
+        out: &mut [u8],
+    ) {
+        let inverse = (self.inverse_far + self.step * f64::from(k)) as f32;
+        let row = y * reference.width;
+        let codes = &reference.codes[row..row + out.len()];
+        let valid = &reference.valid[row..row + out.len()];
+        sums.fill((0, 0));
+        for (v, (view, other)) in self.views.iter().zip(others).enumerate() {
+            let rays = rays.view(v, out.len());
+            let b = view.translation.map(|v| v * inverse);
+            let (w, h) = (other.width as f32, other.height as f32);
+            let stride = other.width as u32;
+            // First the nearest pixel of every column (branch-free, so it vectorises), then
+            // the lookups.
+            for (j, a) in landing.iter_mut().zip(rays) {
+                let qz = a[2] + b[2];
+                let inv = 1.0 / qz;
+                // Nearest pixel: truncation equals floor for the non-negative values kept.
+                let (u, v) = ((a[0] + b[0]) * inv + 0.5, (a[1] + b[1]) * inv + 0.5);
+                let inside = qz > 1e-6 && u >= 0.0 && v >= 0.0 && u < w && v < h;
+                *j = if inside {
+                    v as u32 * stride + u as u32
+                } else {
+                    u32::MAX
+                };
+            }
+            for (((sum, &j), &code), &ok) in sums.iter_mut().zip(&*landing).zip(codes).zip(valid) {
+                if j == u32::MAX || !ok {
+                    continue;
+                }
+                let j = j as usize;
+                if other.valid[j] {
+                    sum.0 += (code ^ other.codes[j]).count_ones() as u16;
+                    sum.1 += 1;
+                }
+            }
+        }
+        for (cost, &(sum, n)) in out.iter_mut().zip(sums.iter()) {
+            *cost = if n == 0 {
+                (u32::from(CENSUS_MAX_COST) * COST_SCALE) as u8
+            } else {
+                let n = u32::from(n);
+                ((u32::from(sum) * COST_SCALE + n / 2) / n) as u8
+            };
+        }
+    }
+}
+
+/// `M x̃` of one row for every view: view `v`'s rays start at `v · stride + offset` in `rays`.
+#[derive(Clone, Copy)]
+struct RowRays<'a> {
+    rays: &'a [[f32; 3]],
+    stride: usize,
+    offset: usize,
+}
+
+impl<'a> RowRays<'a> {
+    /// View `v`'s rays for the row's `width` pixels.
+    fn view(&self, v: usize, width: usize) -> &'a [[f32; 3]] {
+        let start = v * self.stride + self.offset;
+        &self.rays[start..start + width]
+    }
+}
+
+impl SweepView {
+    /// The view of `other` from `reference` and the fastest image motion per unit of inverse
+    /// depth over the swept range (sampled over a grid of pixels and depths).
+    fn new(
+        reference: &Frame,
+        other: &Frame,
+        inverse_near: f64,
+        inverse_far: f64,
+    ) -> Result<(Self, f64)> {
         let other_from_reference =
             other.world_from_camera().inverse() * reference.world_from_camera();
         let t = other_from_reference.translation.vector;
@@ -84,10 +245,6 @@ impl Sweep {
             * other_from_reference.rotation.to_rotation_matrix().matrix()
             * k_reference_inverse;
         let b = k_other * t;
-        let (inverse_near, inverse_far) =
-            (1.0 / near, if far.is_finite() { 1.0 / far } else { 0.0 });
-        // The largest image motion per unit of inverse depth over a grid of pixels and depths
-        // bounds the plane step.
         let (w, h) = (f64::from(kr.width()), f64::from(kr.height()));
         let mut rate: f64 = 0.0;
         for (fx, fy) in
@@ -112,35 +269,12 @@ impl Sweep {
                 previous = Some(p);
             }
         }
-        let planes = (rate * (inverse_near - inverse_far)).ceil() + 1.0;
-        if !(planes.is_finite() && planes <= f64::from(MAX_DISPARITIES)) {
-            return Err(Error::InvalidParameter {
-                name: "plane count for the depth range",
-                value: planes,
-                expected: "1 to 1024 planes (narrow the depth range)",
-            });
-        }
-        let planes = planes.max(2.0) as u32;
-        let step = (inverse_near - inverse_far) / f64::from(planes - 1);
         let cast = |v: f64| v as f32;
-        Ok(Self {
+        let view = Self {
             homography: std::array::from_fn(|r| std::array::from_fn(|c| cast(m[(r, c)]))),
             translation: [cast(b.x), cast(b.y), cast(b.z)],
-            inverse_far,
-            step,
-            planes,
-        })
-    }
-
-    /// The geometry that maps a (fractional) plane index to depth in the reference camera.
-    pub(crate) fn geometry(&self, reference: &Frame) -> Result<StereoGeometry> {
-        let fx = reference.intrinsics().fx();
-        StereoGeometry::new(
-            *reference.intrinsics(),
-            *reference.world_from_camera(),
-            1.0 / (self.step * fx),
-            self.inverse_far / self.step,
-        )
+        };
+        Ok((view, rate))
     }
 
     /// `M x̃` for every pixel of reference row `y`.
@@ -155,41 +289,6 @@ impl Sweep {
                 m2[0] * xf + m2[1] * yf + m2[2],
             ]
         }));
-    }
-
-    /// Raw census costs of reference row `y` (whose rays are `rays`) on plane `k`, written
-    /// into `out` (one per column).
-    fn row_costs(
-        &self,
-        y: usize,
-        rays: &[[f32; 3]],
-        k: u32,
-        reference: &CensusImage,
-        other: &CensusImage,
-        out: &mut [u8],
-    ) {
-        let inverse = (self.inverse_far + self.step * f64::from(k)) as f32;
-        let b = self.translation.map(|v| v * inverse);
-        let (w, h) = (other.width as f32, other.height as f32);
-        let row = y * reference.width;
-        let codes = &reference.codes[row..row + out.len()];
-        let valid = &reference.valid[row..row + out.len()];
-        for (((cost, a), &code), &ok) in out.iter_mut().zip(rays).zip(codes).zip(valid) {
-            *cost = CENSUS_MAX_COST;
-            let qz = a[2] + b[2];
-            if qz <= 1e-6 || !ok {
-                continue;
-            }
-            let inv = 1.0 / qz;
-            // Nearest pixel: truncation equals floor for the non-negative values kept.
-            let (u, v) = ((a[0] + b[0]) * inv + 0.5, (a[1] + b[1]) * inv + 0.5);
-            if u >= 0.0 && v >= 0.0 && u < w && v < h {
-                let j = v as usize * other.width + u as usize;
-                if other.valid[j] {
-                    *cost = (code ^ other.codes[j]).count_ones() as u8;
-                }
-            }
-        }
     }
 }
 
@@ -297,7 +396,7 @@ fn aggregate(
 fn sweep_band(
     sweep: &Sweep,
     reference: &CensusImage,
-    other: &CensusImage,
+    others: &[CensusImage],
     params: &MatchParams,
     y0: usize,
     y1: usize,
@@ -310,20 +409,38 @@ fn sweep_band(
     );
     let first = y0.saturating_sub(radius.1);
     let last = (y1 + radius.1).min(height);
-    let mut rays = Vec::with_capacity((last - first) * width);
-    for y in first..last {
-        sweep.row_rays(y, width, &mut rays);
+    // Each view's rays for the band's rows, view after view.
+    let rows = last - first;
+    let mut rays = Vec::with_capacity(sweep.views.len() * rows * width);
+    for view in &sweep.views {
+        for y in first..last {
+            view.row_rays(y, width, &mut rays);
+        }
     }
-    let mut raw = vec![0u8; (last - first) * width];
+    let mut raw = vec![0u8; rows * width];
     let mut horizontal = vec![0u16; raw.len()];
+    let mut sums = vec![(0u16, 0u8); width];
+    let mut landing = vec![0u32; width];
     let n = (y1 - y0) * width;
     // The band's aggregated costs on every plane, plane after plane.
     let mut volume = vec![0u16; n * sweep.planes as usize];
     for (k, costs) in volume.chunks_exact_mut(n).enumerate() {
         for (r, row) in raw.chunks_exact_mut(width).enumerate() {
-            let y = first + r;
-            let rays = &rays[r * width..(r + 1) * width];
-            sweep.row_costs(y, rays, k as u32, reference, other, row);
+            let row_rays = RowRays {
+                rays: &rays,
+                stride: rows * width,
+                offset: r * width,
+            };
+            sweep.row_costs(
+                first + r,
+                row_rays,
+                k as u32,
+                reference,
+                others,
+                &mut sums,
+                &mut landing,
+                row,
+            );
         }
         aggregate(
             &raw,
@@ -369,17 +486,25 @@ fn sweep_band(
     state
 }
 
-/// Matches a pair by plane sweep in the reference camera; the result's "disparity" is the
+/// Matches `reference` against the sweep's other views (`others`, in the order the sweep was
+/// made with) by plane sweep in the reference camera; the result's "disparity" is the
 /// fractional plane index.
-pub(crate) fn sweep_pair(
+pub(crate) fn sweep_views(
     reference: &Frame,
-    other: &Frame,
+    others: &[&Frame],
     sweep: &Sweep,
     params: &MatchParams,
 ) -> Result<DisparityMap> {
     params.validate()?;
+    if others.len() != sweep.views.len() {
+        return Err(Error::SizeMismatch {
+            what: "views of the plane sweep",
+            expected: sweep.views.len(),
+            found: others.len(),
+        });
+    }
     let left = census_transform(reference.image());
-    let right = census_transform(other.image());
+    let right: Vec<CensusImage> = others.iter().map(|o| census_transform(o.image())).collect();
     let (width, height) = (left.width, left.height);
     if width == 0 || height == 0 {
         return Err(Error::Empty("reference image"));
@@ -400,7 +525,8 @@ pub(crate) fn sweep_pair(
         range_low: vec![f32::NAN; n],
         range_high: vec![f32::NAN; n],
     };
-    let max_cost = u32::from(CENSUS_MAX_COST) * params.window_width * params.window_height;
+    let max_cost =
+        u32::from(CENSUS_MAX_COST) * COST_SCALE * params.window_width * params.window_height;
     let ratio = params.uniqueness_ratio;
     for (i, s) in states.iter().flatten().enumerate() {
         if s.best == u16::MAX || u32::from(s.best) >= max_cost || s.low > s.high {
@@ -442,7 +568,7 @@ mod tests {
         let image = GrayImage::new(64, 48, vec![0.5; 64 * 48]).unwrap();
         let a = frame(image.clone(), k, 0.0, 0.0);
         let b = frame(image, k, 0.0, -0.5);
-        let sweep = Sweep::new(&a, &b, 2.0, 20.0).unwrap();
+        let sweep = Sweep::new(&a, &[&b], 2.0, 20.0).unwrap();
         let geometry = sweep.geometry(&a).unwrap();
         let near = geometry.depth(f64::from(sweep.planes - 1)).unwrap();
         let far = geometry.depth(0.0).unwrap();
@@ -458,13 +584,13 @@ mod tests {
         let image = GrayImage::new(16, 16, vec![0.5; 256]).unwrap();
         let a = frame(image.clone(), k, 0.0, 0.0);
         assert!(matches!(
-            Sweep::new(&a, &a, 1.0, 10.0),
+            Sweep::new(&a, &[&a], 1.0, 10.0),
             Err(Error::Unrectifiable {
                 reason: UnrectifiableReason::ZeroBaseline { .. }
             })
         ));
         let b = frame(image, k, 0.0, -1.0);
-        assert!(Sweep::new(&a, &b, 10.0, 1.0).is_err());
-        assert!(Sweep::new(&a, &b, f64::NAN, 1.0).is_err());
+        assert!(Sweep::new(&a, &[&b], 10.0, 1.0).is_err());
+        assert!(Sweep::new(&a, &[&b], f64::NAN, 1.0).is_err());
     }
 }

@@ -11,7 +11,7 @@ use super::flights::{
 };
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
-use crate::depth::{DepthParams, ForwardMotion, MatchMethod, depth_from_pair};
+use crate::depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions};
 use crate::map::{
@@ -38,6 +38,12 @@ pub struct ExperimentConfig {
     pub flights: Option<FlightConfig>,
     /// Pairs (by index) whose depth-stage output is kept for figures.
     pub sample_pairs: Vec<usize>,
+    /// Camera views behind each depth image. 2 (the default, the paper's depth stage): each
+    /// pair on its own. `N > 2`: each pair's two views and the `N - 2` most recent earlier
+    /// camera positions of the same phase, matched at once by a multiple-baseline plane sweep
+    /// ([`depth_from_views`]); a phase's first pair, with no earlier views, is matched on its
+    /// own. At most 17.
+    pub views: usize,
 }
 
 impl Default for ExperimentConfig {
@@ -52,6 +58,7 @@ impl Default for ExperimentConfig {
             seed: 1,
             flights: None,
             sample_pairs: Vec::new(),
+            views: 2,
         }
     }
 }
@@ -106,7 +113,13 @@ pub struct ExperimentReport {
     pub pairs: usize,
     /// Pairs the depth stage could not use.
     pub rejected_pairs: usize,
-    /// Pairs matched by plane sweep (motion along the view) rather than rectified.
+    /// Camera views behind each depth image (see [`ExperimentConfig::views`]).
+    pub views: usize,
+    /// Earlier views left out, summed over the pairs, because with them the plane sweep would
+    /// need more than 1024 planes (the longest baseline too long for the depth range).
+    pub views_dropped: usize,
+    /// Pairs matched by plane sweep (motion along the view, or several views) rather than
+    /// rectified.
     pub swept_pairs: usize,
     /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, `fuzzy:OP`.
     pub maps: BTreeMap<String, MapReport>,
@@ -132,6 +145,7 @@ pub fn run_experiment_with_progress(
     config: &ExperimentConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<ExperimentOutput> {
+    let mut window = ViewWindow::new(config.views)?;
     let mut maps: Vec<(String, AnyMap)> = vec![
         (
             "logodds".into(),
@@ -178,6 +192,8 @@ pub fn run_experiment_with_progress(
     let mut done = 0;
     let last_phase = scenario.phases.len().saturating_sub(1);
     for (phase_index, (phase, range)) in scenario.phases.iter().enumerate() {
+        // Multi-view depth uses earlier views of the same phase only.
+        window.clear();
         for index in range.clone() {
             let Some((reference, other)) = scenario.pairs.get(index) else {
                 continue;
@@ -196,11 +212,11 @@ pub fn run_experiment_with_progress(
                 b.to_frame(scenario.intrinsics, *other, time)?,
             );
             let t = Instant::now();
-            let result = depth_from_pair(&a, &b, &depth);
+            let result = window.depth(a, b, &depth);
             depth_s += t.elapsed().as_secs_f64();
             let depth_frame: DepthFrame = match result {
                 Ok(result) => {
-                    swept += usize::from(result.method == MatchMethod::PlaneSweep);
+                    swept += usize::from(result.method != MatchMethod::Rectified);
                     if config.sample_pairs.contains(&index) {
                         samples.push(DepthSample {
                             pair: index,
@@ -290,6 +306,8 @@ pub fn run_experiment_with_progress(
         scenario: scenario.name.to_string(),
         pairs: scenario.pairs.len(),
         rejected_pairs: rejected,
+        views: config.views,
+        views_dropped: window.views_dropped(),
         swept_pairs: swept,
         maps: maps_report,
         truth_flights: summary_of("truth"),
