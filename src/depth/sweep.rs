@@ -29,7 +29,7 @@
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 
-use super::census::{CENSUS_MAX_COST, CensusImage, census_transform};
+use super::census::{CENSUS_BITS, CENSUS_MAX_COST, CensusImage, census_transform};
 use super::frame::Frame;
 use super::params::{DisparityMap, MAX_DISPARITIES, MatchParams};
 use super::rectify::{MIN_BASELINE, StereoGeometry, UnrectifiableReason};
@@ -46,6 +46,9 @@ const COST_SCALE: u32 = 8;
 /// The parameter an [`Error::InvalidParameter`] names when a sweep would need more than
 /// [`MAX_DISPARITIES`] planes.
 pub const PLANE_COUNT: &str = "plane count for the depth range";
+
+/// Longest image side, in pixels, of a view the sweep matches against (see `floor_small`).
+pub const MAX_SWEEP_SIDE: u32 = 1 << 20;
 
 /// Most other views one sweep matches against (a pixel's cost sums and counts stay small).
 pub const MAX_SWEEP_VIEWS: usize = 16;
@@ -134,79 +137,212 @@ impl Sweep {
 
     /// Raw costs of reference row `y` on plane `k`, written into `out` (one per column): the
     /// mean census distance over the views in which the pixel lands on a valid pixel, scaled by
-    /// [`COST_SCALE`], or the largest cost where it lands in none. `sums` and `landing` are
-    /// scratch space of the row's width.
-    #[allow(clippy::too_many_arguments)]
+    /// [`COST_SCALE`], or the largest cost where it lands in none. `reference` holds the row's
+    /// tagged codes (see [`tagged_codes`]).
     fn row_costs(
         &self,
-        y: usize,
         rays: RowRays<'_>,
         k: u32,
-        reference: &CensusImage,
-        others: &[CensusImage],
-        sums: &mut [(u16, u8)],
-        landing: &mut [u32],
+        reference: &[u32],
+        others: &[TaggedImage],
+        scratch: &mut RowScratch,
         out: &mut [u8],
     ) {
         let inverse = (self.inverse_far + self.step * f64::from(k)) as f32;
-        let row = y * reference.width;
-        let codes = &reference.codes[row..row + out.len()];
-        let valid = &reference.valid[row..row + out.len()];
-        sums.fill((0, 0));
+        let width = out.len();
+        let RowScratch {
+            landing,
+            gathered,
+            sums,
+            counts,
+        } = scratch;
+        sums.fill(0);
+        counts.fill(0);
         for (v, (view, other)) in self.views.iter().zip(others).enumerate() {
-            let rays = rays.view(v, out.len());
+            let (xs, ys, zs) = rays.view(v, width);
             let b = view.translation.map(|v| v * inverse);
             let (w, h) = (other.width as f32, other.height as f32);
             let stride = other.width as u32;
-            // First the nearest pixel of every column (branch-free, so it vectorises), then
-            // the lookups.
-            for (j, a) in landing.iter_mut().zip(rays) {
-                let qz = a[2] + b[2];
+            // The nearest pixel of every column, branch-free so that it vectorises; -1 where
+            // the pixel lands outside the image (or behind the camera). Truncation equals
+            // floor for the non-negative values kept.
+            for (((j, &ax), &ay), &az) in landing.iter_mut().zip(xs).zip(ys).zip(zs) {
+                let qz = az + b[2];
                 let inv = 1.0 / qz;
-                // Nearest pixel: truncation equals floor for the non-negative values kept.
-                let (u, v) = ((a[0] + b[0]) * inv + 0.5, (a[1] + b[1]) * inv + 0.5);
+                let (u, v) = ((ax + b[0]) * inv + 0.5, (ay + b[1]) * inv + 0.5);
                 let inside = qz > 1e-6 && u >= 0.0 && v >= 0.0 && u < w && v < h;
-                *j = if inside {
-                    v as u32 * stride + u as u32
-                } else {
-                    u32::MAX
-                };
+                let index = floor_small(v)
+                    .wrapping_mul(stride)
+                    .wrapping_add(floor_small(u));
+                *j = if inside { index as i32 } else { -1 };
             }
-            for (((sum, &j), &code), &ok) in sums.iter_mut().zip(&*landing).zip(codes).zip(valid) {
-                if j == u32::MAX || !ok {
-                    continue;
-                }
-                let j = j as usize;
-                if other.valid[j] {
-                    sum.0 += (code ^ other.codes[j]).count_ones() as u16;
-                    sum.1 += 1;
-                }
+            for (g, &j) in gathered.iter_mut().zip(landing.iter()) {
+                *g = usize::try_from(j)
+                    .ok()
+                    .and_then(|j| other.codes.get(j))
+                    .copied()
+                    .unwrap_or(INVALID);
+            }
+            // Distances where both codes are valid, again branch-free.
+            for (((sum, count), &g), &c) in sums
+                .iter_mut()
+                .zip(counts.iter_mut())
+                .zip(gathered.iter())
+                .zip(reference)
+            {
+                let both = ((g | c) >> 31) ^ 1;
+                *sum += ((c ^ g).count_ones() * both) as u16;
+                *count += both as u16;
             }
         }
-        for (cost, &(sum, n)) in out.iter_mut().zip(sums.iter()) {
-            *cost = if n == 0 {
-                (u32::from(CENSUS_MAX_COST) * COST_SCALE) as u8
-            } else {
-                let n = u32::from(n);
-                ((u32::from(sum) * COST_SCALE + n / 2) / n) as u8
-            };
+        for ((cost, &sum), &count) in out.iter_mut().zip(sums.iter()).zip(counts.iter()) {
+            *cost = mean_cost(sum, count);
         }
     }
 }
 
-/// `M x̃` of one row for every view: view `v`'s rays start at `v · stride + offset` in `rays`.
+/// `2^23`: adding it to a float below `2^22` leaves its integer part in the mantissa.
+const MAGIC: f32 = 8_388_608.0;
+
+/// `floor(x)` for `0 <= x < 2^22`, anything for other `x`, without a branch: unlike `as`,
+/// which must saturate, this vectorises. Views are at most [`MAX_SWEEP_SIDE`] pixels a side.
+#[inline(always)]
+fn floor_small(x: f32) -> u32 {
+    let nearest = (x + MAGIC) - MAGIC;
+    let floor = if nearest > x { nearest - 1.0 } else { nearest };
+    (floor + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits())
+}
+
+/// Bit 31 of a tagged census code: the pixel has no code and matches nothing. Census strings
+/// use the bits below it.
+const INVALID: u32 = 1 << 31;
+const _: () = assert!(CENSUS_BITS <= 31);
+
+/// A census image with each pixel's validity folded into its code (see [`INVALID`]).
+struct TaggedImage {
+    width: usize,
+    height: usize,
+    codes: Vec<u32>,
+}
+
+/// The codes of `census` with invalid pixels tagged [`INVALID`].
+fn tagged_codes(census: &CensusImage) -> TaggedImage {
+    TaggedImage {
+        width: census.width,
+        height: census.height,
+        codes: census
+            .codes
+            .iter()
+            .zip(&census.valid)
+            .map(|(&code, &ok)| if ok { code } else { INVALID })
+            .collect(),
+    }
+}
+
+/// `ceil(2^18 / n)` for `n` = 0 ..= [`MAX_SWEEP_VIEWS`] (0 unused): dividing by a view count
+/// as a multiplication and a shift, exact for the numerators [`mean_cost`] forms.
+const RECIPROCALS: [u32; MAX_SWEEP_VIEWS + 1] = {
+    let mut table = [0u32; MAX_SWEEP_VIEWS + 1];
+    let mut n = 1;
+    while n <= MAX_SWEEP_VIEWS {
+        table[n] = (1u32 << 18).div_ceil(n as u32);
+        n += 1;
+    }
+    table
+};
+
+/// `round(sum · COST_SCALE / count)`, or the largest cost when no view saw the pixel.
+#[inline]
+fn mean_cost(sum: u16, count: u16) -> u8 {
+    match RECIPROCALS.get(usize::from(count)) {
+        Some(&reciprocal) if count > 0 => {
+            let count = u32::from(count);
+            // At most 31 · 16 · 8 + 8 < 2^13, so the product stays below 2^31 and the
+            // multiplication equals the division (numerator · count < 2^18).
+            (((u32::from(sum) * COST_SCALE + count / 2) * reciprocal) >> 18) as u8
+        }
+        _ => (u32::from(CENSUS_MAX_COST) * COST_SCALE) as u8,
+    }
+}
+
+/// One row's scratch space for [`Sweep::row_costs`].
+struct RowScratch {
+    landing: Vec<i32>,
+    gathered: Vec<u32>,
+    sums: Vec<u16>,
+    counts: Vec<u16>,
+}
+
+impl RowScratch {
+    fn new(width: usize) -> Self {
+        Self {
+            landing: vec![0; width],
+            gathered: vec![0; width],
+            sums: vec![0; width],
+            counts: vec![0; width],
+        }
+    }
+}
+
+/// `M x̃` of the band's rows for every view, as three planes (x, y, z) so that the landing
+/// loop vectorises: view `v`'s row `r` starts at `(v · rows + r) · width`.
+struct BandRays {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    rows: usize,
+    width: usize,
+}
+
+impl BandRays {
+    fn new(sweep: &Sweep, first: usize, last: usize, width: usize) -> Self {
+        let rows = last - first;
+        let n = sweep.views.len() * rows * width;
+        let mut rays = Self {
+            x: Vec::with_capacity(n),
+            y: Vec::with_capacity(n),
+            z: Vec::with_capacity(n),
+            rows,
+            width,
+        };
+        for view in &sweep.views {
+            let [m0, m1, m2] = view.homography;
+            for y in first..last {
+                let yf = y as f32;
+                for x in 0..width {
+                    let xf = x as f32;
+                    rays.x.push(m0[0] * xf + m0[1] * yf + m0[2]);
+                    rays.y.push(m1[0] * xf + m1[1] * yf + m1[2]);
+                    rays.z.push(m2[0] * xf + m2[1] * yf + m2[2]);
+                }
+            }
+        }
+        rays
+    }
+
+    /// Row `r` (counted from the band's first row) for every view.
+    fn row(&self, r: usize) -> RowRays<'_> {
+        RowRays { band: self, r }
+    }
+}
+
+/// One row of [`BandRays`].
 #[derive(Clone, Copy)]
 struct RowRays<'a> {
-    rays: &'a [[f32; 3]],
-    stride: usize,
-    offset: usize,
+    band: &'a BandRays,
+    r: usize,
 }
 
 impl<'a> RowRays<'a> {
-    /// View `v`'s rays for the row's `width` pixels.
-    fn view(&self, v: usize, width: usize) -> &'a [[f32; 3]] {
-        let start = v * self.stride + self.offset;
-        &self.rays[start..start + width]
+    /// View `v`'s x, y and z planes for the row's `width` pixels.
+    fn view(&self, v: usize, width: usize) -> (&'a [f32], &'a [f32], &'a [f32]) {
+        let start = (v * self.band.rows + self.r) * self.band.width;
+        let range = start..start + width;
+        (
+            &self.band.x[range.clone()],
+            &self.band.y[range.clone()],
+            &self.band.z[range],
+        )
     }
 }
 
@@ -229,6 +365,13 @@ impl SweepView {
         }
         let kr = reference.intrinsics();
         let ko = other.intrinsics();
+        if ko.width().max(ko.height()) > MAX_SWEEP_SIDE {
+            return Err(Error::InvalidParameter {
+                name: "image side of a plane-sweep view",
+                value: f64::from(ko.width().max(ko.height())),
+                expected: "at most 1,048,576 pixels",
+            });
+        }
         let k_other = Matrix3::new(ko.fx(), 0.0, ko.cx(), 0.0, ko.fy(), ko.cy(), 0.0, 0.0, 1.0);
         let k_reference_inverse = Matrix3::new(
             1.0 / kr.fx(),
@@ -246,6 +389,12 @@ impl SweepView {
             * k_reference_inverse;
         let b = k_other * t;
         let (w, h) = (f64::from(kr.width()), f64::from(kr.height()));
+        // Where a pixel lands far outside the other image it costs nothing, and next to the
+        // other camera's plane its motion grows without bound: only motion within the image
+        // grown by its own size on every side counts.
+        let (ow, oh) = (f64::from(ko.width()), f64::from(ko.height()));
+        let near_image =
+            |p: (f64, f64)| (-ow..2.0 * ow).contains(&p.0) && (-oh..2.0 * oh).contains(&p.1);
         let mut rate: f64 = 0.0;
         for (fx, fy) in
             (0..5).flat_map(|i| (0..5).map(move |j| (f64::from(i) / 4.0, f64::from(j) / 4.0)))
@@ -262,6 +411,10 @@ impl SweepView {
                     continue;
                 }
                 let p = (q.x / q.z, q.y / q.z);
+                if !near_image(p) {
+                    previous = None;
+                    continue;
+                }
                 if let Some(prev) = previous {
                     let moved = ((p.0 - prev.0).powi(2) + (p.1 - prev.1).powi(2)).sqrt();
                     rate = rate.max(moved * f64::from(SAMPLES) / (inverse_near - inverse_far));
@@ -275,20 +428,6 @@ impl SweepView {
             translation: [cast(b.x), cast(b.y), cast(b.z)],
         };
         Ok((view, rate))
-    }
-
-    /// `M x̃` for every pixel of reference row `y`.
-    fn row_rays(&self, y: usize, width: usize, out: &mut Vec<[f32; 3]>) {
-        let [m0, m1, m2] = self.homography;
-        let yf = y as f32;
-        out.extend((0..width).map(|x| {
-            let xf = x as f32;
-            [
-                m0[0] * xf + m0[1] * yf + m0[2],
-                m1[0] * xf + m1[1] * yf + m1[2],
-                m2[0] * xf + m2[1] * yf + m2[2],
-            ]
-        }));
     }
 }
 
@@ -395,8 +534,8 @@ fn aggregate(
 /// Sweeps one band of rows `y0 .. y1` through every plane, twice, and returns its pixels' state.
 fn sweep_band(
     sweep: &Sweep,
-    reference: &CensusImage,
-    others: &[CensusImage],
+    reference: &TaggedImage,
+    others: &[TaggedImage],
     params: &MatchParams,
     y0: usize,
     y1: usize,
@@ -409,38 +548,18 @@ fn sweep_band(
     );
     let first = y0.saturating_sub(radius.1);
     let last = (y1 + radius.1).min(height);
-    // Each view's rays for the band's rows, view after view.
-    let rows = last - first;
-    let mut rays = Vec::with_capacity(sweep.views.len() * rows * width);
-    for view in &sweep.views {
-        for y in first..last {
-            view.row_rays(y, width, &mut rays);
-        }
-    }
-    let mut raw = vec![0u8; rows * width];
+    let rays = BandRays::new(sweep, first, last, width);
+    let mut raw = vec![0u8; (last - first) * width];
     let mut horizontal = vec![0u16; raw.len()];
-    let mut sums = vec![(0u16, 0u8); width];
-    let mut landing = vec![0u32; width];
+    let mut scratch = RowScratch::new(width);
     let n = (y1 - y0) * width;
     // The band's aggregated costs on every plane, plane after plane.
     let mut volume = vec![0u16; n * sweep.planes as usize];
     for (k, costs) in volume.chunks_exact_mut(n).enumerate() {
         for (r, row) in raw.chunks_exact_mut(width).enumerate() {
-            let row_rays = RowRays {
-                rays: &rays,
-                stride: rows * width,
-                offset: r * width,
-            };
-            sweep.row_costs(
-                first + r,
-                row_rays,
-                k as u32,
-                reference,
-                others,
-                &mut sums,
-                &mut landing,
-                row,
-            );
+            let y = first + r;
+            let codes = &reference.codes[y * width..(y + 1) * width];
+            sweep.row_costs(rays.row(r), k as u32, codes, others, &mut scratch, row);
         }
         aggregate(
             &raw,
@@ -503,8 +622,11 @@ pub(crate) fn sweep_views(
             found: others.len(),
         });
     }
-    let left = census_transform(reference.image());
-    let right: Vec<CensusImage> = others.iter().map(|o| census_transform(o.image())).collect();
+    let left = tagged_codes(&census_transform(reference.image()));
+    let right: Vec<TaggedImage> = others
+        .iter()
+        .map(|o| tagged_codes(&census_transform(o.image())))
+        .collect();
     let (width, height) = (left.width, left.height);
     if width == 0 || height == 0 {
         return Err(Error::Empty("reference image"));
@@ -553,6 +675,35 @@ pub(crate) fn sweep_views(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_small_is_floor_and_mean_cost_is_the_rounded_mean() {
+        let mut x = 0.0f32;
+        while x < 3000.0 {
+            for y in [
+                x,
+                x.next_up(),
+                (x + 0.5).next_down(),
+                x + 0.5,
+                (x + 1.0).next_down(),
+            ] {
+                assert_eq!(floor_small(y), y as u32, "{y}");
+            }
+            x += 0.999;
+        }
+        let edge = (MAX_SWEEP_SIDE as f32).next_down();
+        assert_eq!(floor_small(edge), edge as u32);
+        for count in 1..=MAX_SWEEP_VIEWS as u16 {
+            for sum in 0..=u16::from(CENSUS_MAX_COST) * count {
+                let exact = (u32::from(sum) * COST_SCALE + u32::from(count) / 2) / u32::from(count);
+                assert_eq!(u32::from(mean_cost(sum, count)), exact, "{sum} / {count}");
+            }
+        }
+        assert_eq!(
+            u32::from(mean_cost(0, 0)),
+            u32::from(CENSUS_MAX_COST) * COST_SCALE
+        );
+    }
     use crate::depth::GrayImage;
     use crate::geometry::PinholeIntrinsics;
     use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -592,5 +743,24 @@ mod tests {
         let b = frame(image, k, 0.0, -1.0);
         assert!(Sweep::new(&a, &[&b], 10.0, 1.0).is_err());
         assert!(Sweep::new(&a, &[&b], f64::NAN, 1.0).is_err());
+        // No views, too many, and a view wider than the sweep's pixel arithmetic allows.
+        assert!(matches!(
+            Sweep::new(&a, &[], 1.0, 10.0),
+            Err(Error::Empty(_))
+        ));
+        let crowd = vec![&b; MAX_SWEEP_VIEWS + 1];
+        assert!(Sweep::new(&a, &crowd, 1.0, 10.0).is_err());
+        let side = MAX_SWEEP_SIDE + 1;
+        let wide_k = PinholeIntrinsics::new(side, 1, 20.0, 20.0, 7.5, 0.0).unwrap();
+        let wide = frame(
+            GrayImage::new(side, 1, vec![0.5; side as usize]).unwrap(),
+            wide_k,
+            0.0,
+            -1.0,
+        );
+        assert!(matches!(
+            Sweep::new(&a, &[&wide], 1.0, 10.0),
+            Err(Error::InvalidParameter { .. })
+        ));
     }
 }

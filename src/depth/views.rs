@@ -177,9 +177,13 @@ mod tests {
     #[test]
     fn views_that_need_too_many_planes_are_left_out() {
         let mut window = ViewWindow::new(3).unwrap();
-        let params = params();
-        window.depth(frame(-100.0), frame(-100.1), &params).unwrap();
-        // A 100 m baseline needs thousands of planes over 2–20 m: that view is left out.
+        let params = DepthParams {
+            depth_range: Some((0.05, 1000.0)),
+            ..params()
+        };
+        window.depth(frame(-1.0), frame(-1.1), &params).unwrap();
+        // Over 5 cm to 1 km the pair's 0.1 m baseline needs 120 planes, the earlier position's
+        // 1.1 m about 1,300: that view is left out.
         let result = window.depth(frame(0.1), frame(0.0), &params).unwrap();
         assert_eq!(result.views, 2);
         assert_eq!(window.views_dropped(), 1);

@@ -75,12 +75,24 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
     let report = &output.report;
     let name = scenario.name;
     let mut md = String::new();
+    let matching = if report.views > 2 {
+        format!(
+            "each depth image from up to {} camera views (the pair and the most recent earlier \
+             positions of its phase, {} earlier views left out for the plane limit), {} matched \
+             by plane sweep",
+            report.views, report.views_dropped, report.swept_pairs
+        )
+    } else {
+        format!(
+            "{} matched by plane sweep because the camera moved along its view",
+            report.swept_pairs
+        )
+    };
     let _ = writeln!(
         md,
-        "## {name} scenario\n\n{} stereo pairs ({} matched by plane sweep because the camera \
-         moved along its view, {} refused by the depth stage); {} truly occupied voxels in the \
-         region the cameras saw.\n",
-        report.pairs, report.swept_pairs, report.rejected_pairs, report.truth_occupied
+        "## {name} scenario\n\n{} stereo pairs ({matching}, {} refused by the depth stage); {} \
+         truly occupied voxels in the region the cameras saw.\n",
+        report.pairs, report.rejected_pairs, report.truth_occupied
     );
     table(&mut md, report, None);
     let phases: Vec<String> = report
