@@ -41,8 +41,8 @@ pub struct ExperimentConfig {
     /// Camera views behind each depth image. 2 (the default, the paper's depth stage): each
     /// pair on its own. `N > 2`: each pair's two views and the `N - 2` most recent earlier
     /// camera positions of the same phase, matched at once by a multiple-baseline plane sweep
-    /// ([`depth_from_views`]); a phase's first pair, with no earlier views, is matched on its
-    /// own. At most 17.
+    /// ([`depth_from_views`](crate::depth::depth_from_views)); a phase's first pair, with no
+    /// earlier views, is matched on its own. At most 17.
     pub views: usize,
 }
 
