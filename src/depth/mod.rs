@@ -34,5 +34,5 @@ pub use pipeline::{
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
 pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry, UnrectifiableReason};
-pub use sweep::{MAX_SWEEP_VIEWS, PLANE_COUNT};
+pub use sweep::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
 pub use views::ViewWindow;

@@ -185,8 +185,10 @@ pub fn depth_by_plane_sweep(
 /// best `Q_ABD` between the reference and any of the views. `params.depth_range` is required.
 ///
 /// Errors: no other view or more than [`MAX_SWEEP_VIEWS`](super::MAX_SWEEP_VIEWS), invalid
-/// poses, a view at the reference's position, a depth range that needs more than 1024 planes
-/// for the longest baseline, invalid parameters.
+/// poses, a view at the reference's position, a view larger than
+/// [`MAX_SWEEP_SIDE`](super::MAX_SWEEP_SIDE) a side or [`MAX_SWEEP_PIXELS`](super::MAX_SWEEP_PIXELS)
+/// in all, a depth range that needs more than 1024 planes for the longest baseline, invalid
+/// parameters.
 pub fn depth_from_views(
     reference: &Frame,
     others: &[&Frame],

@@ -50,6 +50,10 @@ pub const PLANE_COUNT: &str = "plane count for the depth range";
 /// Longest image side, in pixels, of a view the sweep matches against (see `floor_small`).
 pub const MAX_SWEEP_SIDE: u32 = 1 << 20;
 
+/// Most pixels of a view the sweep matches against: a pixel's index in it must fit an `i32`
+/// (the landing loop's `-1` marks "outside").
+pub const MAX_SWEEP_PIXELS: u64 = (1 << 31) - 1;
+
 /// Most other views one sweep matches against (a pixel's cost sums and counts stay small).
 pub const MAX_SWEEP_VIEWS: usize = 16;
 
@@ -370,6 +374,14 @@ impl SweepView {
                 name: "image side of a plane-sweep view",
                 value: f64::from(ko.width().max(ko.height())),
                 expected: "at most 1,048,576 pixels",
+            });
+        }
+        let pixels = u64::from(ko.width()) * u64::from(ko.height());
+        if pixels > MAX_SWEEP_PIXELS {
+            return Err(Error::InvalidParameter {
+                name: "pixels of a plane-sweep view",
+                value: pixels as f64,
+                expected: "at most 2^31 - 1 pixels",
             });
         }
         let k_other = Matrix3::new(ko.fx(), 0.0, ko.cx(), 0.0, ko.fy(), ko.cy(), 0.0, 0.0, 1.0);
