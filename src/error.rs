@@ -89,6 +89,9 @@ pub enum Error {
     /// An aggregation operator's parameters are invalid or its name unknown.
     #[error(transparent)]
     Operator(#[from] OperatorError),
+    /// One item of a list that must not repeat was given twice (an experiment's operators).
+    #[error("{0} is listed twice")]
+    Duplicate(String),
     /// Two maps cannot be combined.
     #[error("maps are incompatible: {0}")]
     Incompatible(String),

@@ -514,6 +514,12 @@ fn eval_refuses_bad_resolutions_and_operators_before_working() {
         1,
         "dombi",
     );
+    // `max` and `min` name one t-conorm: its map would be listed twice.
+    fails(
+        &["eval", "--scenario", "wall", "--ops", "max,min"],
+        1,
+        "the operator maximum is listed twice",
+    );
     fails(&["eval", "--scenario", "moon"], 2, "invalid value");
 }
 

@@ -37,7 +37,7 @@ fn eval_wall_reports_every_map_after_each_phase_with_flights_and_figures() {
         "--json",
     ]));
     assert_eq!(report["scenario"], "wall");
-    for name in ["logodds", "alpha", "fuzzy", "fuzzy:minimum"] {
+    for name in ["logodds", "alpha", "fuzzy", "fuzzy:maximum"] {
         let map = &report["maps"][name];
         for key in [
             "occupied_precision",

@@ -12,7 +12,7 @@ use super::flights::{
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
 use crate::depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::integrate::{DepthFrame, IntegrationOptions};
 use crate::map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, VoxelMap,
@@ -26,7 +26,9 @@ use crate::sim::{RenderedFrame, render};
 pub struct ExperimentConfig {
     /// Voxel size of every map, metres.
     pub resolution: f64,
-    /// Extra fuzzy maps, one per operator (the default fuzzy map uses the probabilistic sum).
+    /// Extra fuzzy maps, one per operator (the default fuzzy map uses the probabilistic sum),
+    /// each named `fuzzy:` and its t-conorm's name ([`TConorm`]'s `Display`: `fuzzy:maximum`,
+    /// `fuzzy:dombi:2`). Listing one operator twice is an error.
     pub operators: Vec<Family>,
     /// The depth stage's settings (its depth range defaults to 1 m .. the scenario's range;
     /// forward-motion pairs go through the plane sweep by default, as the paper feeds every
@@ -121,7 +123,8 @@ pub struct ExperimentReport {
     /// Pairs matched by plane sweep (motion along the view, or several views) rather than
     /// rectified.
     pub swept_pairs: usize,
-    /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, `fuzzy:OP`.
+    /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, and `fuzzy:OP` with `OP` the
+    /// extra operator's t-conorm (`fuzzy:maximum`).
     pub maps: BTreeMap<String, MapReport>,
     /// Flights planned in the gold-standard map, the reference for path lengths.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -161,11 +164,13 @@ pub fn run_experiment_with_progress(
         ),
     ];
     for family in &config.operators {
-        let fuzzy = FuzzyConfig::new(config.resolution)?.with_operator(TConorm::new(*family)?);
-        maps.push((
-            format!("fuzzy:{family}"),
-            AnyMap::Fuzzy(FuzzyMap::new(fuzzy)?),
-        ));
+        let operator = TConorm::new(*family)?;
+        let name = format!("fuzzy:{operator}");
+        if maps.iter().any(|(existing, _)| *existing == name) {
+            return Err(Error::Duplicate(format!("the operator {operator}")));
+        }
+        let fuzzy = FuzzyConfig::new(config.resolution)?.with_operator(operator);
+        maps.push((name, AnyMap::Fuzzy(FuzzyMap::new(fuzzy)?)));
     }
     let mut seconds = BTreeMap::new();
     let started = Instant::now();

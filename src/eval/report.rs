@@ -10,7 +10,7 @@ use super::metrics::MapMetrics;
 use crate::error::Result;
 use crate::sim::scenario::Scenario;
 
-/// File-name form of a map name (`fuzzy:dombi(2)` → `fuzzy_dombi(2)`).
+/// File-name form of a map name (`fuzzy:dombi:2` → `fuzzy_dombi_2`).
 pub fn file_stem(name: &str) -> String {
     name.chars()
         .map(|c| {

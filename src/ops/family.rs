@@ -147,6 +147,20 @@ impl Family {
         }
     }
 
+    /// The name of the family's t-conorm: `maximum`, `probabilistic-sum`, `bounded-sum`,
+    /// `drastic-sum`, `nilpotent-maximum`, and the family's own name for the parametric
+    /// families and Einstein. `FromStr` accepts each of them.
+    pub fn conorm_name(&self) -> &'static str {
+        match self {
+            Family::Minimum => "maximum",
+            Family::Product => "probabilistic-sum",
+            Family::Lukasiewicz => "bounded-sum",
+            Family::Drastic => "drastic-sum",
+            Family::NilpotentMinimum => "nilpotent-maximum",
+            _ => self.name(),
+        }
+    }
+
     /// The family's parameter, or `None` for the non-parametric families.
     pub fn parameter(&self) -> Option<f64> {
         match *self {
@@ -232,11 +246,13 @@ enum Named {
 fn lookup(key: &str) -> Option<Named> {
     use Named::{Fixed, Parametric};
     Some(match key {
-        "minimum" | "min" | "max" | "godel" | "gödel" => Fixed(Family::Minimum),
-        "product" | "prod" | "probsum" | "probabilistic" => Fixed(Family::Product),
+        "minimum" | "min" | "max" | "maximum" | "godel" | "gödel" => Fixed(Family::Minimum),
+        "product" | "prod" | "probsum" | "probabilistic" | "probabilistic-sum" => {
+            Fixed(Family::Product)
+        }
         "lukasiewicz" | "łukasiewicz" | "bounded" | "bounded-sum" => Fixed(Family::Lukasiewicz),
-        "drastic" => Fixed(Family::Drastic),
-        "nilpotent-minimum" | "nilpotent" => Fixed(Family::NilpotentMinimum),
+        "drastic" | "drastic-sum" => Fixed(Family::Drastic),
+        "nilpotent-minimum" | "nilpotent" | "nilpotent-maximum" => Fixed(Family::NilpotentMinimum),
         "einstein" => Fixed(Family::Einstein),
         "hamacher" => Parametric(|gamma| Family::Hamacher { gamma }),
         "yager" => Parametric(|p| Family::Yager { p }),
@@ -297,7 +313,7 @@ impl FromStr for Family {
 /// Formats a parameter so that it parses back to the same `f64`; Rust's float
 /// formatting is shortest-round-trip, and exponent notation keeps extreme
 /// values short.
-fn write_parameter(f: &mut fmt::Formatter<'_>, value: f64) -> fmt::Result {
+pub(super) fn write_parameter(f: &mut fmt::Formatter<'_>, value: f64) -> fmt::Result {
     let magnitude = value.abs();
     if magnitude != 0.0 && !(1e-4..1e6).contains(&magnitude) {
         write!(f, "{value:e}")
@@ -522,6 +538,11 @@ mod tests {
             };
             let text = family.to_string();
             prop_assert_eq!(text.parse::<Family>(), Ok(family), "{}", text);
+            // The t-conorm's name reads back as the same family too.
+            if let Ok(conorm) = crate::ops::TConorm::new(family) {
+                let text = conorm.to_string();
+                prop_assert_eq!(text.parse::<Family>(), Ok(family), "{}", text);
+            }
         }
 
         /// Arbitrary text never panics the parser.

@@ -144,6 +144,19 @@ impl Default for TConorm {
     }
 }
 
+impl std::fmt::Display for TConorm {
+    /// Writes the t-conorm's name, `NAME` or `NAME:PARAM` (`maximum`, `probabilistic-sum`,
+    /// `dombi:2`, see [`Family::conorm_name`]); `Family`'s `FromStr` reads it back.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.family.conorm_name())?;
+        if let Some(value) = self.family.parameter() {
+            f.write_str(":")?;
+            super::family::write_parameter(f, value)?;
+        }
+        Ok(())
+    }
+}
+
 impl TryFrom<Family> for TConorm {
     type Error = OperatorError;
 
