@@ -2,13 +2,14 @@
 //! matching, intervals and confidence) and fuzzy frustum integration, on pairs of the
 //! simulator's random flight. Criterion reports time per pair; pairs per second = 1 / time.
 //! The rendering of the views is outside the measured loop. `multi_view` is one depth image
-//! from five views (a pair and its three earlier positions, `fuzzyvox eval --views 5`).
+//! from five views (a pair and its three earlier positions, chosen by the same [`ViewWindow`]
+//! as `fuzzyvox eval --views 5`).
 //!
 //! Run: `cargo bench --bench pipeline`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use fuzzyvox::depth::{
-    DepthParams, ForwardMotion, Frame, MatchMethod, depth_from_pair, depth_from_views,
+    DepthParams, ForwardMotion, Frame, MatchMethod, ViewWindow, depth_from_pair,
 };
 use fuzzyvox::sim::scenario;
 use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, VoxelMap};
@@ -31,22 +32,28 @@ fn frames(params: &DepthParams) -> Vec<(Frame, Frame, Option<MatchMethod>)> {
     pairs
 }
 
-/// Five views per depth image as `eval --views 5` picks them: pair `k`'s two views (positions
-/// `k + 1` and `k`) and the reference views of pairs `k - 2 .. k - 4` (positions `k - 1 .. k - 3`).
-fn view_sets(
+/// Windows of five views per depth image, as `eval --views 5` builds them: for pair `k`, a
+/// [`ViewWindow`] that remembers the flight's pairs before it (the random flight is one phase),
+/// kept where its five-view sweep fits the plane limit.
+fn windows(
     pairs: &[(Frame, Frame, Option<MatchMethod>)],
     params: &DepthParams,
-) -> Vec<(usize, [usize; 3])> {
-    (4..pairs.len())
-        .map(|k| (k, [k - 2, k - 3, k - 4]))
-        .filter(|(k, earlier)| {
-            let others: Vec<&Frame> = std::iter::once(&pairs[*k].1)
-                .chain(earlier.iter().map(|&j| &pairs[j].0))
-                .collect();
-            depth_from_views(&pairs[*k].0, &others, params).is_ok()
-        })
-        .take(8)
-        .collect()
+) -> Vec<(usize, ViewWindow)> {
+    let mut window = ViewWindow::new(5).expect("window");
+    let mut chosen = Vec::new();
+    for (k, (reference, other, _)) in pairs.iter().enumerate() {
+        if chosen.len() == 8 {
+            break;
+        }
+        if window
+            .preview(reference, other, params)
+            .is_ok_and(|r| r.views == 5)
+        {
+            chosen.push((k, window.clone()));
+        }
+        window.remember(reference.clone(), other.clone());
+    }
+    chosen
 }
 
 fn pipeline(c: &mut Criterion) {
@@ -88,18 +95,16 @@ fn pipeline(c: &mut Criterion) {
             })
         });
     }
-    let sets = view_sets(&pairs, &params);
-    assert!(!sets.is_empty(), "no five-view set fits the plane sweep");
+    let windows = windows(&pairs, &params);
+    assert!(!windows.is_empty(), "no five-view set fits the plane sweep");
     group.bench_function("multi_view_5_depth_and_fuzzy_integration", |b| {
         let mut i = 0;
         let mut map = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap();
         b.iter(|| {
-            let (k, earlier) = &sets[i % sets.len()];
+            let (k, window) = &windows[i % windows.len()];
             i += 1;
-            let others: Vec<&Frame> = std::iter::once(&pairs[*k].1)
-                .chain(earlier.iter().map(|&j| &pairs[j].0))
-                .collect();
-            let result = depth_from_views(&pairs[*k].0, &others, &params).unwrap();
+            let (reference, other, _) = &pairs[*k];
+            let result = window.preview(reference, other, &params).unwrap();
             map.integrate_depth(&result.frame, &options).unwrap()
         })
     });

@@ -68,7 +68,27 @@ impl ViewWindow {
         other: Frame,
         params: &DepthParams,
     ) -> Result<DepthResult> {
-        let result = self.match_views(&reference, &other, params);
+        let (result, dropped) = self.match_views(&reference, &other, params);
+        self.dropped += dropped;
+        self.remember(reference, other);
+        result
+    }
+
+    /// The depth that [`ViewWindow::depth`] would give the pair now, without remembering its
+    /// frames or counting left-out views: to match one pair against the same earlier positions
+    /// more than once (a benchmark), or to look before committing a pair to the window.
+    pub fn preview(
+        &self,
+        reference: &Frame,
+        other: &Frame,
+        params: &DepthParams,
+    ) -> Result<DepthResult> {
+        self.match_views(reference, other, params).0
+    }
+
+    /// Remembers a pair's frames as earlier positions for the pairs that follow, without
+    /// matching it (a window of two views remembers nothing).
+    pub fn remember(&mut self, reference: Frame, other: Frame) {
         if self.views > 2 {
             self.history.push(other);
             self.history.push(reference);
@@ -76,15 +96,15 @@ impl ViewWindow {
             let excess = self.history.len().saturating_sub(2 * self.views);
             self.history.drain(..excess);
         }
-        result
     }
 
+    /// The pair's depth and how many earlier positions had to be left out.
     fn match_views(
-        &mut self,
+        &self,
         reference: &Frame,
         other: &Frame,
         params: &DepthParams,
-    ) -> Result<DepthResult> {
+    ) -> (Result<DepthResult>, usize) {
         let mut others = vec![other];
         let position = |f: &Frame| f.world_from_camera().translation.vector;
         for frame in self.history.iter().rev() {
@@ -97,16 +117,17 @@ impl ViewWindow {
                 others.push(frame);
             }
         }
+        let mut dropped = 0;
         while others.len() > 1 {
             match depth_from_views(reference, &others, params) {
                 Err(Error::InvalidParameter { name, .. }) if name == PLANE_COUNT => {
                     others.pop();
-                    self.dropped += 1;
+                    dropped += 1;
                 }
-                result => return result,
+                result => return (result, dropped),
             }
         }
-        depth_from_pair(reference, other, params)
+        (depth_from_pair(reference, other, params), dropped)
     }
 }
 
@@ -187,5 +208,36 @@ mod tests {
         let result = window.depth(frame(0.1), frame(0.0), &params).unwrap();
         assert_eq!(result.views, 2);
         assert_eq!(window.views_dropped(), 1);
+    }
+
+    #[test]
+    fn preview_matches_as_depth_would_and_changes_nothing() {
+        let mut window = ViewWindow::new(4).unwrap();
+        window.remember(frame(0.1), frame(0.0));
+        window.remember(frame(0.2), frame(0.1));
+        let remembered = window.history.len();
+        // Depth as bits (NaN where a pixel has none).
+        let bits = |r: &DepthResult| -> Vec<u32> {
+            r.frame
+                .image()
+                .depth()
+                .iter()
+                .map(|d| d.to_bits())
+                .collect()
+        };
+        let preview = window.preview(&frame(0.3), &frame(0.2), &params()).unwrap();
+        assert_eq!(preview.views, 4);
+        assert!(preview.frame.image().depth().iter().any(|d| d.is_finite()));
+        // Previewing twice gives the same bits: the window did not change.
+        let again = window.preview(&frame(0.3), &frame(0.2), &params()).unwrap();
+        assert_eq!(bits(&preview), bits(&again));
+        assert_eq!(window.history.len(), remembered);
+        let committed = window.depth(frame(0.3), frame(0.2), &params()).unwrap();
+        assert_eq!(bits(&preview), bits(&committed));
+        assert_eq!(window.history.len(), remembered + 2);
+        // A window of two views remembers nothing.
+        let mut pairs = ViewWindow::new(2).unwrap();
+        pairs.remember(frame(0.1), frame(0.0));
+        assert!(pairs.history.is_empty());
     }
 }
