@@ -74,6 +74,31 @@ fn eval_wall_reports_every_map_after_each_phase_with_flights_and_figures() {
 }
 
 #[test]
+fn eval_with_several_views_reports_how_they_were_weighted() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "eval",
+            "--scenario",
+            "wall",
+            "--res",
+            "0.25",
+            "--views",
+            "3",
+        ];
+        args.extend_from_slice(extra);
+        args.push("--json");
+        json(&fuzzyvox(&args))
+    };
+    let (weighted, unweighted) = (run(&[]), run(&["--unweighted-views"]));
+    assert_eq!(weighted["views"], 3);
+    assert_eq!(weighted["weigh_reused_views"], true);
+    assert_eq!(unweighted["weigh_reused_views"], false);
+    // Only the maps that weigh evidence by confidence change.
+    assert_eq!(weighted["maps"]["logodds"], unweighted["maps"]["logodds"]);
+    assert_ne!(weighted["maps"]["fuzzy"], unweighted["maps"]["fuzzy"]);
+}
+
+#[test]
 fn eval_refuses_bad_arguments() {
     fails_with(
         &fuzzyvox(&["eval", "--scenario", "random", "--pairs", "0"]),

@@ -284,6 +284,49 @@ fn frustum_frees_space_in_front_occupies_the_wall_and_leaves_behind_unknown() {
 }
 
 #[test]
+fn a_depth_frame_scaled_to_half_weight_counts_as_half_an_observation() {
+    // Two frames at half weight equal one at full weight (probabilistic sum), in the frustum
+    // integration as in the point integrator; the standard map ignores the weight.
+    let frame = wall_frame(Point3::new(0.0, 0.0, 0.5), 3.0);
+    let mut halved = frame.clone();
+    halved.scale_confidence(0.5).unwrap();
+    let mut half = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    half.integrate_depth(&halved, &Default::default()).unwrap();
+    half.integrate_depth(&halved, &Default::default()).unwrap();
+    let mut full = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    full.integrate_depth(&frame, &Default::default()).unwrap();
+    assert!(max_difference(&half, &full) < 1e-5);
+    // One half-weight frame leaves the wall voxel below a full one's membership.
+    let mut once = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    once.integrate_depth(&halved, &Default::default()).unwrap();
+    let wall = Point3::new(3.05, 0.05, 0.55);
+    let (weak, strong) = (
+        once.memberships_at_point(&wall).unwrap().occupied,
+        full.memberships_at_point(&wall).unwrap().occupied,
+    );
+    assert!(weak > 0.0 && weak < strong, "{weak} vs {strong}");
+    let standard = |f: &fuzzyvox::DepthFrame| {
+        let mut map =
+            fuzzyvox::LogOddsMap::new(fuzzyvox::LogOddsConfig::new(0.1).unwrap()).unwrap();
+        map.integrate_depth(f, &Default::default()).unwrap();
+        map.cells().collect::<Vec<_>>()
+    };
+    assert_eq!(standard(&frame), standard(&halved));
+    // Weights outside (0, 1] are refused and leave the frame as it was.
+    let mut kept = frame.clone();
+    for bad in [0.0, -0.5, 1.5, f32::NAN, f32::INFINITY] {
+        assert!(matches!(
+            kept.scale_confidence(bad),
+            Err(fuzzyvox::Error::InvalidParameter { name: "weight", .. })
+        ));
+    }
+    let bits = |f: &fuzzyvox::DepthFrame| -> Vec<u32> {
+        f.image().confidence().iter().map(|c| c.to_bits()).collect()
+    };
+    assert_eq!(bits(&kept), bits(&frame));
+}
+
+#[test]
 fn box_queries_agree_with_cell_scans() {
     let scans = scans();
     let map = build(config(Family::Product), &[&scans[0], &scans[1]]);

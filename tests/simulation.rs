@@ -124,6 +124,33 @@ fn the_wall_experiment_with_several_views_per_depth_image() {
         spurious(&several),
         spurious(&pairs)
     );
+    // Weighting each image by 2 / views (the default) against counting each as a full
+    // observation: the standard map ignores confidence and is the same; the fuzzy map, which
+    // no longer counts the images' shared views several times, puts fewer voxels behind the
+    // wall and in the sky.
+    assert!(several.weigh_reused_views);
+    let unweighted = run_experiment(
+        &scenario,
+        &ExperimentConfig {
+            resolution: 0.25,
+            views: 4,
+            weigh_reused_views: false,
+            ..ExperimentConfig::default()
+        },
+    )
+    .unwrap()
+    .report;
+    assert_eq!(
+        unweighted.maps["logodds"].metrics,
+        several.maps["logodds"].metrics
+    );
+    let fuzzy = |report: &fuzzyvox::eval::ExperimentReport| report.maps["fuzzy"].metrics;
+    let (weighted, unweighted) = (fuzzy(&several), fuzzy(&unweighted));
+    assert!(
+        weighted.occupied_precision > unweighted.occupied_precision + 0.05
+            && weighted.spurious_unknown <= unweighted.spurious_unknown,
+        "{weighted:?} weighted, {unweighted:?} unweighted"
+    );
     let config = ExperimentConfig {
         views: 1,
         ..ExperimentConfig::default()

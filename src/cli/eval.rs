@@ -42,6 +42,10 @@ pub struct EvalArgs {
     /// same phase and matches them at once (multiple-baseline plane sweep).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=17))]
     views: u32,
+    /// With `--views` above 2: give each depth image full weight instead of `2 / views` (by
+    /// default images that share views count as one pair's worth of evidence each).
+    #[arg(long)]
+    unweighted_views: bool,
     /// Plan this many random flights in every map and check them against the true scene.
     #[arg(long, default_value_t = 0)]
     plan: usize,
@@ -149,6 +153,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         args.unknown.policy(args.unknown_cost),
     );
     config.views = args.views as usize;
+    config.weigh_reused_views = !args.unweighted_views;
     let started = Instant::now();
     let output = run_with_bar(&scenario, &config, args.json)?;
     let seconds = started.elapsed().as_secs_f64();
@@ -170,8 +175,14 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     }
     let views = if report.views > 2 {
         format!(
-            ", up to {} views per depth image ({} earlier views left out)",
-            report.views, report.views_dropped
+            ", up to {} views per depth image ({} earlier views left out; {})",
+            report.views,
+            report.views_dropped,
+            if report.weigh_reused_views {
+                "each image weighted 2 / views"
+            } else {
+                "unweighted"
+            }
         )
     } else {
         String::new()

@@ -73,6 +73,23 @@ pub struct DepthResult {
     pub matching_seconds: f64,
 }
 
+impl DepthResult {
+    /// How much of an observation this depth image is worth when consecutive images of a flight
+    /// share views: `2 / views`, 1 for a pair.
+    ///
+    /// In a flight matched pair by pair each camera position feeds two depth images (as one
+    /// pair's reference and the next pair's other view); matched with `N - 2` earlier
+    /// positions ([`ViewWindow`](super::ViewWindow)) it feeds `N`, and consecutive images,
+    /// sharing most of their views, repeat each other's errors. An aggregation that treats
+    /// observations as independent (the probabilistic sum) would count those errors `N / 2`
+    /// times as often as with pairs. Scaling the image's confidence by this weight
+    /// ([`DepthFrame::scale_confidence`](crate::integrate::DepthFrame::scale_confidence))
+    /// keeps every position's total weight what the paper's pairs give it.
+    pub fn reuse_weight(&self) -> f32 {
+        2.0 / self.views.max(2) as f32
+    }
+}
+
 /// Depth from a rectified pair (`left(y, x)` matches `right(y, x - d)`) with known geometry.
 pub fn depth_from_rectified(
     left: &GrayImage,

@@ -170,14 +170,17 @@ mod tests {
         assert!(ViewWindow::new(MAX_SWEEP_VIEWS + 2).is_err());
         let mut window = ViewWindow::new(4).unwrap();
         // A chain of pairs sharing positions, as a flight gives: (0.1, 0), (0.2, 0.1), ...
-        let mut used = Vec::new();
+        let (mut used, mut weights) = (Vec::new(), Vec::new());
         for i in 1..=4 {
             let x = 0.1 * f64::from(i);
             let result = window.depth(frame(x), frame(x - 0.1), &params()).unwrap();
             used.push(result.views);
+            weights.push(result.reuse_weight());
         }
         // The first pair alone, then one and two earlier positions (the shared one counts once).
         assert_eq!(used, vec![2, 3, 4, 4]);
+        // Their weights when images sharing views are counted as pairs: 2 / views.
+        assert_eq!(weights, vec![1.0, 2.0 / 3.0, 0.5, 0.5]);
         window.clear();
         let result = window.depth(frame(1.0), frame(0.9), &params()).unwrap();
         assert_eq!(result.views, 2);

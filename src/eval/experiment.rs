@@ -46,6 +46,11 @@ pub struct ExperimentConfig {
     /// ([`depth_from_views`](crate::depth::depth_from_views)); a phase's first pair, with no
     /// earlier views, is matched on its own. At most 17.
     pub views: usize,
+    /// Whether each depth image's confidence is scaled by its
+    /// [`reuse_weight`](crate::depth::DepthResult::reuse_weight) (`2 / views`) before it goes to
+    /// the maps, so that images sharing views are not counted as independent evidence. Changes
+    /// nothing for pairs; default `true`. The log-odds map ignores confidence either way.
+    pub weigh_reused_views: bool,
 }
 
 impl Default for ExperimentConfig {
@@ -61,6 +66,7 @@ impl Default for ExperimentConfig {
             flights: None,
             sample_pairs: Vec::new(),
             views: 2,
+            weigh_reused_views: true,
         }
     }
 }
@@ -117,6 +123,9 @@ pub struct ExperimentReport {
     pub rejected_pairs: usize,
     /// Camera views behind each depth image (see [`ExperimentConfig::views`]).
     pub views: usize,
+    /// Whether images from several views were weighted by how many views they share (see
+    /// [`ExperimentConfig::weigh_reused_views`]).
+    pub weigh_reused_views: bool,
     /// Earlier views left out, summed over the pairs, because with them the plane sweep would
     /// need more than 1024 planes (the longest baseline too long for the depth range).
     pub views_dropped: usize,
@@ -235,7 +244,12 @@ pub fn run_experiment_with_progress(
                             frame: result.frame.clone(),
                         });
                     }
-                    result.frame
+                    let weight = result.reuse_weight();
+                    let mut frame = result.frame;
+                    if config.weigh_reused_views && weight < 1.0 {
+                        frame.scale_confidence(weight)?;
+                    }
+                    frame
                 }
                 Err(_) => {
                     rejected += 1;
@@ -312,6 +326,7 @@ pub fn run_experiment_with_progress(
         pairs: scenario.pairs.len(),
         rejected_pairs: rejected,
         views: config.views,
+        weigh_reused_views: config.weigh_reused_views,
         views_dropped: window.views_dropped(),
         swept_pairs: swept,
         maps: maps_report,

@@ -221,6 +221,28 @@ impl DepthFrame {
         &self.image
     }
 
+    /// Multiplies every pixel's confidence by `weight` in `(0, 1]`: the frame then counts as
+    /// `weight` of an observation in the maps that weigh evidence by confidence (the fuzzy and
+    /// alpha-cut maps; the log-odds map ignores confidence). For depth images that share their
+    /// source views with others, see [`DepthResult::reuse_weight`](crate::depth::DepthResult::reuse_weight).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a weight that is not in `(0, 1]`; the frame is unchanged.
+    pub fn scale_confidence(&mut self, weight: f32) -> Result<()> {
+        if !(weight > 0.0 && weight <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "weight",
+                value: f64::from(weight),
+                expected: "a weight in (0, 1]",
+            });
+        }
+        // In [0, 1] times (0, 1]: still in [0, 1]; NaN (no confidence) stays NaN.
+        for c in &mut self.image.confidence {
+            *c *= weight;
+        }
+        Ok(())
+    }
+
     /// The frame as a point cloud for ray-based maps: every valid pixel back-projected at its
     /// `P0` depth into the world, seen from the camera centre, with its confidence.
     pub fn to_cloud(&self) -> Result<PointCloud> {

@@ -36,7 +36,7 @@ const GROUP: i32 = 8;
 /// makes wide (far, uncertain) intervals commit less per voxel: `f = 1` keeps the evidence
 /// summed along the ray that of one sharp hit, `f = 0` gives every voxel of the interval the full
 /// evidence. The voxel that holds the pixel's `P0` point also gets the full occupied evidence
-/// of a hit (see [`mark_end_points`]). A pixel whose depth exceeds `max_range` clears free space
+/// of a hit (see `mark_end_points`). A pixel whose depth exceeds `max_range` clears free space
 /// up to `max_range` and marks nothing occupied. Invalid pixels contribute nothing.
 ///
 /// Blocks are found by culling the blocks of the frustum's bounding box against the largest far
