@@ -31,7 +31,8 @@ pub struct EvalArgs {
     /// Seed of the random flight, the sensor noise and the flight queries.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Extra fuzzy maps, one per t-conorm (comma-separated NAME[:PARAM]).
+    /// Extra fuzzy maps, one per t-conorm (comma-separated NAME[:PARAM]), each reported as
+    /// `fuzzy:` and the t-conorm's name (`max` gives `fuzzy:maximum`).
     #[arg(long, value_delimiter = ',')]
     ops: Vec<String>,
     /// Voxel size in metres.
