@@ -129,6 +129,14 @@ fn the_wall_experiment_with_several_views_per_depth_image() {
     // no longer counts the images' shared views several times, puts fewer voxels behind the
     // wall and in the sky.
     assert!(several.weigh_reused_views);
+    assert_eq!(pairs.views_summary(), None);
+    assert!(
+        several
+            .views_summary()
+            .is_some_and(|s| s.starts_with("up to 4 views") && s.ends_with("weighted 2 / views")),
+        "{:?}",
+        several.views_summary()
+    );
     let unweighted = run_experiment(
         &scenario,
         &ExperimentConfig {
@@ -140,6 +148,11 @@ fn the_wall_experiment_with_several_views_per_depth_image() {
     )
     .unwrap()
     .report;
+    assert!(
+        unweighted
+            .views_summary()
+            .is_some_and(|s| s.ends_with("images unweighted"))
+    );
     assert_eq!(
         unweighted.maps["logodds"].metrics,
         several.maps["logodds"].metrics

@@ -174,20 +174,9 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     if args.json {
         return super::print_json(&serde_json::to_value(report)?);
     }
-    let views = if report.views > 2 {
-        format!(
-            ", up to {} views per depth image ({} earlier views left out; {})",
-            report.views,
-            report.views_dropped,
-            if report.weigh_reused_views {
-                "each image weighted 2 / views"
-            } else {
-                "unweighted"
-            }
-        )
-    } else {
-        String::new()
-    };
+    let views = report
+        .views_summary()
+        .map_or(String::new(), |summary| format!(", {summary}"));
     println!(
         "{} scenario: {} pairs ({} by plane sweep, {} rejected{views}) in {seconds:.1} s; {} truly occupied voxels",
         report.scenario,

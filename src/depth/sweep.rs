@@ -153,7 +153,6 @@ impl Sweep {
         out: &mut [u8],
     ) {
         let inverse = (self.inverse_far + self.step * f64::from(k)) as f32;
-        let width = out.len();
         let RowScratch {
             landing,
             gathered,
@@ -163,7 +162,7 @@ impl Sweep {
         sums.fill(0);
         counts.fill(0);
         for (v, (view, other)) in self.views.iter().zip(others).enumerate() {
-            let (xs, ys, zs) = rays.view(v, width);
+            let (xs, ys, zs) = rays.view(v);
             let b = view.translation.map(|v| v * inverse);
             let (w, h) = (other.width as f32, other.height as f32);
             let stride = other.width as u32;
@@ -338,10 +337,10 @@ struct RowRays<'a> {
 }
 
 impl<'a> RowRays<'a> {
-    /// View `v`'s x, y and z planes for the row's `width` pixels.
-    fn view(&self, v: usize, width: usize) -> (&'a [f32], &'a [f32], &'a [f32]) {
+    /// View `v`'s x, y and z planes for the row's pixels.
+    fn view(&self, v: usize) -> (&'a [f32], &'a [f32], &'a [f32]) {
         let start = (v * self.band.rows + self.r) * self.band.width;
-        let range = start..start + width;
+        let range = start..start + self.band.width;
         (
             &self.band.x[range.clone()],
             &self.band.y[range.clone()],
@@ -687,6 +686,9 @@ pub(crate) fn sweep_views(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::depth::GrayImage;
+    use crate::geometry::PinholeIntrinsics;
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
     #[test]
     fn floor_small_is_floor_and_mean_cost_is_the_rounded_mean() {
@@ -716,9 +718,6 @@ mod tests {
             u32::from(CENSUS_MAX_COST) * COST_SCALE
         );
     }
-    use crate::depth::GrayImage;
-    use crate::geometry::PinholeIntrinsics;
-    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
     fn frame(image: GrayImage, k: PinholeIntrinsics, x: f64, z: f64) -> Frame {
         let pose = Isometry3::from_parts(Translation3::new(x, 0.0, z), UnitQuaternion::identity());

@@ -144,6 +144,27 @@ pub struct ExperimentReport {
     pub seconds: BTreeMap<String, f64>,
 }
 
+impl ExperimentReport {
+    /// For depth from several views, how they were used: "up to N views per depth image, D
+    /// earlier views left out for the plane limit, each image weighted 2 / views"; `None` for
+    /// pairs.
+    pub fn views_summary(&self) -> Option<String> {
+        (self.views > 2).then(|| {
+            format!(
+                "up to {} views per depth image, {} earlier views left out for the plane \
+                 limit, {}",
+                self.views,
+                self.views_dropped,
+                if self.weigh_reused_views {
+                    "each image weighted 2 / views"
+                } else {
+                    "images unweighted"
+                }
+            )
+        })
+    }
+}
+
 /// Runs a scenario: renders every pair, runs the depth stage once per pair, feeds the same
 /// depth frames to every map, and evaluates every map after each phase against the ground
 /// truth (the scene's geometry inside the region the gold standard observed).
@@ -246,7 +267,7 @@ pub fn run_experiment_with_progress(
                     }
                     let weight = result.reuse_weight();
                     let mut frame = result.frame;
-                    if config.weigh_reused_views && weight < 1.0 {
+                    if config.weigh_reused_views {
                         frame.scale_confidence(weight)?;
                     }
                     frame

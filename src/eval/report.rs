@@ -75,18 +75,12 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
     let report = &output.report;
     let name = scenario.name;
     let mut md = String::new();
-    let matching = if report.views > 2 {
-        format!(
-            "each depth image from up to {} camera views (the pair and the most recent earlier \
-             positions of its phase, {} earlier views left out for the plane limit), {} matched \
-             by plane sweep",
-            report.views, report.views_dropped, report.swept_pairs
-        )
-    } else {
-        format!(
+    let matching = match report.views_summary() {
+        Some(views) => format!("{views}, {} matched by plane sweep", report.swept_pairs),
+        None => format!(
             "{} matched by plane sweep because the camera moved along its view",
             report.swept_pairs
-        )
+        ),
     };
     let _ = writeln!(
         md,
