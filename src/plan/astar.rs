@@ -6,6 +6,7 @@ use ordered_float::OrderedFloat;
 use petgraph::visit::{EdgeRef, IntoEdges};
 use serde::Serialize;
 
+use super::blocker::{Blocker, ObservedExtent};
 use super::config::PlannerConfig;
 use super::cost_field::{CostField, PlanningRegion};
 use super::graph::VoxelGraph;
@@ -39,12 +40,14 @@ pub enum PlanError {
     /// The start or goal lies outside the planning region.
     #[error("the {0} lies outside the planning region")]
     OutOfRegion(&'static str),
-    /// The start voxel cannot be entered (blocked, unsafe, unknown, or too close to an obstacle).
+    /// The start voxel cannot be entered; the [`Blocker`] says why (outside the observed
+    /// extent, unknown, occupied, ambiguous, low safety, or too close to a blocked voxel) and
+    /// what would change it.
     #[error("the start is not safe: {0}")]
-    StartUnsafe(String),
-    /// The goal voxel cannot be entered.
+    StartUnsafe(Blocker),
+    /// The goal voxel cannot be entered; the [`Blocker`] says why.
     #[error("the goal is not safe: {0}")]
-    GoalUnsafe(String),
+    GoalUnsafe(Blocker),
     /// Start and goal are not connected through traversable voxels.
     #[error(
         "the goal is not connected to the start through safe space ({expanded} voxels searched)"
@@ -58,9 +61,24 @@ pub enum PlanError {
     Map(#[from] Error),
 }
 
+impl PlanError {
+    /// Why the start or goal was refused, for [`PlanError::StartUnsafe`] and
+    /// [`PlanError::GoalUnsafe`].
+    pub fn blocker(&self) -> Option<&Blocker> {
+        match self {
+            Self::StartUnsafe(why) | Self::GoalUnsafe(why) => Some(why),
+            _ => None,
+        }
+    }
+}
+
 /// Plans from `from` to `to` in any map: builds the cost field of the box around both points
 /// grown by a margin (the vehicle radius plus the preferred clearance plus 2 m), then runs
 /// [`plan_in_field`].
+///
+/// A start or goal in unknown space that also lies outside the map's [`ObservedExtent`] is
+/// reported as [`Blocker::OutsideObservedExtent`] rather than [`Blocker::Unknown`]: a point
+/// off the map is usually a mistyped coordinate or a map of the wrong place.
 pub fn plan_path(
     map: &dyn VoxelMap,
     from: &Point3<f64>,
@@ -74,7 +92,24 @@ pub fn plan_path(
     let margin = config.vehicle_radius + config.preferred_clearance + 2.0;
     let region = PlanningRegion::around(&resolution, from, to, margin)?;
     let field = CostField::build(map, region, config)?;
-    plan_in_field(&field, start, goal)
+    // The extent costs a pass over the map, so it is only computed for an unknown end point.
+    let off_map = |point: &Point3<f64>, key: VoxelKey| {
+        ObservedExtent::of(map)
+            .filter(|extent| !extent.contains(key))
+            .map_or(Blocker::Unknown, |extent| Blocker::OutsideObservedExtent {
+                point: *point,
+                extent,
+            })
+    };
+    match plan_in_field(&field, start, goal) {
+        Err(PlanError::StartUnsafe(Blocker::Unknown)) => {
+            Err(PlanError::StartUnsafe(off_map(from, start)))
+        }
+        Err(PlanError::GoalUnsafe(Blocker::Unknown)) => {
+            Err(PlanError::GoalUnsafe(off_map(to, goal)))
+        }
+        result => result,
+    }
 }
 
 /// A* from `start` to `goal` over the field's 26-connected graph (through petgraph's
@@ -93,11 +128,11 @@ pub fn plan_in_field(
     let goal_index = region
         .index_of(goal)
         .ok_or(PlanError::OutOfRegion("goal"))?;
-    if !field.is_traversable(start_index) {
-        return Err(PlanError::StartUnsafe(why_not(field, start_index)));
+    if let Some(why) = field.blocker(start_index) {
+        return Err(PlanError::StartUnsafe(why));
     }
-    if !field.is_traversable(goal_index) {
-        return Err(PlanError::GoalUnsafe(why_not(field, goal_index)));
+    if let Some(why) = field.blocker(goal_index) {
+        return Err(PlanError::GoalUnsafe(why));
     }
     // Metres of the shortest 26-connected route times the lowest rate: never more than the
     // true remaining cost, and consistent because every step costs at least its length times
@@ -184,24 +219,6 @@ pub fn plan_in_field(
         min_clearance,
         expanded,
     })
-}
-
-/// Why a voxel cannot be entered, in words.
-fn why_not(field: &CostField, index: usize) -> String {
-    let required = field.config().vehicle_radius + 3f64.sqrt() * field.resolution().size();
-    let clearance = f64::from(field.clearance(index));
-    if clearance == 0.0 {
-        format!(
-            "the voxel is blocked (occupied, ambiguous, unknown or safety {:.2} below {:.2})",
-            field.safety(index),
-            field.config().safety_threshold
-        )
-    } else {
-        format!(
-            "the nearest blocked voxel is {clearance:.2} m away; {required:.2} m is needed for a vehicle of radius {:.2} m",
-            field.config().vehicle_radius
-        )
-    }
 }
 
 /// Calls `visit` with the dense index of every voxel the straight segment between two voxel

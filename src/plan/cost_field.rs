@@ -1,6 +1,7 @@
 use nalgebra::Point3;
 use rayon::prelude::*;
 
+use super::blocker::{Blocker, NearestBlocked};
 use super::config::{PlannerConfig, UnknownPolicy};
 use super::edt::squared_distance_transform;
 use crate::error::{Error, Result};
@@ -116,6 +117,7 @@ pub struct CostField {
     resolution: Resolution,
     config: PlannerConfig,
     traversable: Vec<bool>,
+    class: Vec<VoxelClass>,
     safety: Vec<f32>,
     clearance: Vec<f32>,
     rate: Vec<f32>,
@@ -139,14 +141,9 @@ impl CostField {
                 (m.safety, m.class)
             })
             .collect();
-        let unknown_allowed = matches!(config.unknown, UnknownPolicy::Cost(_));
         let blocked: Vec<bool> = measures
             .iter()
-            .map(|&(safety, class)| match class {
-                VoxelClass::Occupied | VoxelClass::Ambiguous => true,
-                VoxelClass::Unknown => !unknown_allowed,
-                VoxelClass::Free => safety < config.safety_threshold,
-            })
+            .map(|&(safety, class)| is_blocked(class, safety, &config))
             .collect();
         let clearance = clearance_in_metres(&blocked, region.dims(), resolution.size());
         let required = (config.vehicle_radius + 3f64.sqrt() * resolution.size()) as f32;
@@ -179,6 +176,7 @@ impl CostField {
             resolution,
             config,
             traversable,
+            class: measures.iter().map(|m| m.1).collect(),
             safety: measures.iter().map(|m| m.0).collect(),
             clearance,
             rate,
@@ -205,6 +203,101 @@ impl CostField {
     #[inline]
     pub fn is_traversable(&self, index: usize) -> bool {
         self.traversable.get(index).copied().unwrap_or(false)
+    }
+
+    /// Whether the voxel at a dense index is blocked itself (occupied, ambiguous, free with
+    /// safety below the threshold, or unknown while unknown space is forbidden); outside the
+    /// region everything is blocked.
+    pub fn is_blocked(&self, index: usize) -> bool {
+        index >= self.region.len()
+            || is_blocked(self.class(index), self.safety(index), &self.config)
+    }
+
+    /// Class of the voxel at a dense index ([`VoxelClass::Unknown`] outside the region).
+    pub fn class(&self, index: usize) -> VoxelClass {
+        self.class
+            .get(index)
+            .copied()
+            .unwrap_or(VoxelClass::Unknown)
+    }
+
+    /// Why the voxel at a dense index may not be entered, or `None` when it may (or lies
+    /// outside the region). Blocked voxels report their class, safety or the policy that
+    /// blocks them; voxels that are not blocked themselves report their clearance, what the
+    /// vehicle needs, and the nearest blocked voxel.
+    pub fn blocker(&self, index: usize) -> Option<Blocker> {
+        if index >= self.region.len() || self.is_traversable(index) {
+            return None;
+        }
+        let safety = self.safety(index);
+        if self.is_blocked(index) {
+            return Some(match self.class(index) {
+                VoxelClass::Occupied => Blocker::Occupied { safety },
+                VoxelClass::Ambiguous => Blocker::Ambiguous { safety },
+                VoxelClass::Unknown => Blocker::Unknown,
+                VoxelClass::Free => Blocker::LowSafety {
+                    safety,
+                    threshold: self.config.safety_threshold,
+                },
+            });
+        }
+        let clearance = f64::from(self.clearance(index));
+        let margin = 3f64.sqrt() * self.resolution.size();
+        Some(Blocker::TooClose {
+            clearance,
+            required: self.config.vehicle_radius + margin,
+            vehicle_radius: self.config.vehicle_radius,
+            largest_radius: clearance - margin,
+            nearest: self.nearest_blocked(index, clearance),
+        })
+    }
+
+    /// The blocked voxel at `clearance` metres from the voxel at `index` (the first in index
+    /// order when several are), or `None` when only the region's edge is that near. The
+    /// distance transform gives the distance but not the voxel, so this searches the cube of
+    /// that half-width: only failed requests call it.
+    fn nearest_blocked(&self, index: usize, clearance: f64) -> Option<NearestBlocked> {
+        let size = self.resolution.size();
+        let reach = (clearance / size).ceil() as i64 + 1;
+        let here = self.region.key_at(index);
+        let lowest = self.region.min();
+        let dims = self.region.dims();
+        // The cube of half-width `reach` around the voxel, clipped to the region, as offsets.
+        let span = |axis: usize, at: i32, min: i32| {
+            let offset = i64::from(at) - i64::from(min);
+            (-reach).max(-offset)..=reach.min(dims[axis] as i64 - 1 - offset)
+        };
+        let mut best: Option<(i64, usize)> = None;
+        for dz in span(2, here.z, lowest.z) {
+            for dy in span(1, here.y, lowest.y) {
+                for dx in span(0, here.x, lowest.x) {
+                    let squared = dx * dx + dy * dy + dz * dz;
+                    if best.is_some_and(|(d, _)| squared >= d) {
+                        continue;
+                    }
+                    // Inside the region by construction of the spans.
+                    let key =
+                        VoxelKey::new(here.x + dx as i32, here.y + dy as i32, here.z + dz as i32);
+                    if let Some(other) = self.region.index_of(key)
+                        && self.is_blocked(other)
+                    {
+                        best = Some((squared, other));
+                    }
+                }
+            }
+        }
+        let (squared, other) = best?;
+        let distance = (squared as f64).sqrt() * size;
+        // The edge of the region (blocked by definition) may be nearer than any voxel inside.
+        if distance > clearance + 1e-3 * size {
+            return None;
+        }
+        Some(NearestBlocked {
+            center: self.resolution.center(self.region.key_at(other)),
+            class: self.class(other),
+            safety: self.safety(other),
+            distance,
+        })
     }
 
     /// Safety of the voxel at a dense index.
@@ -238,6 +331,15 @@ impl CostField {
     /// Number of traversable voxels.
     pub fn traversable_count(&self) -> usize {
         self.traversable.iter().filter(|t| **t).count()
+    }
+}
+
+/// Whether a voxel of this class and safety is blocked under `config`.
+fn is_blocked(class: VoxelClass, safety: f32, config: &PlannerConfig) -> bool {
+    match class {
+        VoxelClass::Occupied | VoxelClass::Ambiguous => true,
+        VoxelClass::Unknown => !matches!(config.unknown, UnknownPolicy::Cost(_)),
+        VoxelClass::Free => safety < config.safety_threshold,
     }
 }
 

@@ -12,9 +12,11 @@
 //!    `length × (1 + k (1 - S))` plus a clearance penalty.
 //! 4. [`VoxelGraph`] exposes the field through petgraph's graph traits (no graph is built), so
 //!    petgraph's own `astar` and `dijkstra` run on it; [`plan_path`] runs a dense-array A* with a
-//!    consistent heuristic over the same graph, then shortcuts the path by line of sight.
+//!    consistent heuristic over the same graph, then shortcuts the path by line of sight. A start or goal it may not enter is refused with a
+//!    [`Blocker`] that says why and which setting would change it.
 
 mod astar;
+mod blocker;
 mod config;
 mod cost_field;
 mod edt;
@@ -22,6 +24,7 @@ mod graph;
 mod queries;
 
 pub use astar::{Path, PlanError, plan_in_field, plan_path};
+pub use blocker::{Blocker, NearestBlocked, ObservedExtent};
 pub use config::{PlannerConfig, UnknownPolicy};
 pub use cost_field::{CostField, PlanningRegion};
 pub use edt::squared_distance_transform;
