@@ -19,7 +19,7 @@ use crate::storage::VoxelKey;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Path {
     /// Waypoints in world coordinates (voxel centres), start first, after line-of-sight
-    /// shortcutting.
+    /// shortcutting; no interior waypoint lies on the segment between its neighbours.
     pub waypoints: Vec<Point3<f64>>,
     /// Length of the waypoint polyline in metres.
     pub length: f64,
@@ -115,7 +115,8 @@ pub fn plan_path(
 /// A* from `start` to `goal` over the field's 26-connected graph (through petgraph's
 /// [`IntoEdges`]), with dense per-voxel arrays and the octile distance times the field's lowest
 /// cost rate as a consistent heuristic, then line-of-sight shortcutting checked against the
-/// same field. Ties are broken by node index, so the result is deterministic.
+/// same field and merging of collinear waypoints. Ties are broken by node index, so the result
+/// is deterministic.
 pub fn plan_in_field(
     field: &CostField,
     start: VoxelKey,
@@ -195,7 +196,7 @@ pub fn plan_in_field(
         voxels.push(region.key_at(node));
     }
     voxels.reverse();
-    let corners = shortcut(field, &voxels);
+    let corners = merge_collinear(field, &shortcut(field, &voxels));
     let resolution = field.resolution();
     let waypoints: Vec<Point3<f64>> = corners.iter().map(|k| resolution.center(*k)).collect();
     let length = waypoints.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -267,4 +268,166 @@ fn shortcut(field: &CostField, voxels: &[VoxelKey]) -> Vec<VoxelKey> {
         anchor = next;
     }
     kept
+}
+
+/// Drops every interior waypoint that lies on the straight segment between its neighbours
+/// (within a thousandth of a voxel), so that a path has no redundant corners. Shortcutting
+/// leaves such points when the voxel walk of the longer segment breaks a tie differently; the
+/// merged segment is walked again and kept only when it crosses traversable voxels alone, so
+/// the clearance guarantee of the field holds for the merged path too.
+fn merge_collinear(field: &CostField, corners: &[VoxelKey]) -> Vec<VoxelKey> {
+    let mut kept: Vec<VoxelKey> = Vec::with_capacity(corners.len());
+    for (i, &key) in corners.iter().enumerate() {
+        let next = corners.get(i + 1);
+        let redundant = match (kept.last(), next) {
+            (Some(&before), Some(&after)) => {
+                lies_between(before, key, after)
+                    && segment_voxels(field, before, after, |i| field.is_traversable(i))
+            }
+            _ => false,
+        };
+        if !redundant {
+            kept.push(key);
+        }
+    }
+    kept
+}
+
+/// Whether `middle` lies on the segment from `a` to `b` (within a thousandth of a voxel of
+/// the line, and between the two ends), so that dropping it leaves the path's shape and length
+/// unchanged. A point beyond an end would be a reversal, whose removal would cut a corner.
+fn lies_between(a: VoxelKey, middle: VoxelKey, b: VoxelKey) -> bool {
+    let vector = |from: VoxelKey, to: VoxelKey| {
+        nalgebra::Vector3::new(
+            f64::from(to.x) - f64::from(from.x),
+            f64::from(to.y) - f64::from(from.y),
+            f64::from(to.z) - f64::from(from.z),
+        )
+    };
+    let (along, to_middle) = (vector(a, b), vector(a, middle));
+    let length = along.norm();
+    if length == 0.0 {
+        return false;
+    }
+    let off_line = along.cross(&to_middle).norm() / length;
+    let t = along.dot(&to_middle) / (length * length);
+    off_line <= 1e-3 && (0.0..=1.0).contains(&t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::FunctionMap;
+    use crate::measures::Memberships;
+    use crate::storage::Resolution;
+
+    /// The field of a 4 × 4 × 2 m box of confident free space at 0.1 m, with a 1 m pillar in
+    /// the middle when `pillar`.
+    fn open_field(pillar: bool) -> CostField {
+        let resolution = Resolution::new(0.1).unwrap();
+        let map = FunctionMap::new(resolution, move |key| {
+            let inside_pillar = (18..22).contains(&key.x) && (15..25).contains(&key.y);
+            if pillar && inside_pillar {
+                Memberships {
+                    occupied: 0.9,
+                    free: 0.0,
+                }
+            } else {
+                Memberships {
+                    occupied: 0.0,
+                    free: 0.95,
+                }
+            }
+        });
+        let region =
+            PlanningRegion::new(VoxelKey::new(0, 0, 0), VoxelKey::new(40, 40, 20)).unwrap();
+        let config = PlannerConfig {
+            vehicle_radius: 0.1,
+            ..PlannerConfig::default()
+        };
+        CostField::build(&map, region, config).unwrap()
+    }
+
+    fn keys(points: &[[i32; 3]]) -> Vec<VoxelKey> {
+        points
+            .iter()
+            .map(|&[x, y, z]| VoxelKey::new(x, y, z))
+            .collect()
+    }
+
+    #[test]
+    fn collinear_waypoints_are_merged() {
+        let field = open_field(false);
+        // Two points on the first leg, one on the second, then a turn into z.
+        let corners = keys(&[
+            [5, 5, 5],
+            [7, 7, 5],
+            [10, 10, 5],
+            [10, 20, 5],
+            [10, 30, 5],
+            [10, 30, 10],
+        ]);
+        assert_eq!(
+            merge_collinear(&field, &corners),
+            keys(&[[5, 5, 5], [10, 10, 5], [10, 30, 5], [10, 30, 10]])
+        );
+        // A repeated point is redundant too.
+        assert_eq!(
+            merge_collinear(&field, &keys(&[[5, 5, 5], [5, 5, 5], [9, 5, 5]])),
+            keys(&[[5, 5, 5], [9, 5, 5]])
+        );
+    }
+
+    #[test]
+    fn corners_and_reversals_are_kept() {
+        let field = open_field(false);
+        // Off the line by one voxel: a real corner.
+        let corner = keys(&[[5, 5, 5], [10, 6, 5], [15, 5, 5]]);
+        assert_eq!(merge_collinear(&field, &corner), corner);
+        // On the line but beyond its end: dropping it would cut the path short.
+        let reversal = keys(&[[5, 5, 5], [15, 5, 5], [10, 5, 5]]);
+        assert_eq!(merge_collinear(&field, &reversal), reversal);
+        // Ends alone, and a single point, are left as they are.
+        let two = keys(&[[5, 5, 5], [15, 5, 5]]);
+        assert_eq!(merge_collinear(&field, &two), two);
+        assert_eq!(merge_collinear(&field, &two[..1]), two[..1]);
+    }
+
+    #[test]
+    fn points_within_a_thousandth_of_a_voxel_are_on_the_line() {
+        let (a, b) = (VoxelKey::new(0, 0, 0), VoxelKey::new(10_000, 1, 0));
+        // (5, 0, 0) is 0.0005 voxel off the line from a to b; (5000, 0, 0) is 0.5 off.
+        assert!(lies_between(a, VoxelKey::new(5, 0, 0), b));
+        assert!(!lies_between(a, VoxelKey::new(5000, 0, 0), b));
+        assert!(!lies_between(a, a, a));
+    }
+
+    #[test]
+    fn planned_paths_have_no_collinear_interior_waypoints() {
+        let field = open_field(true);
+        let region = *field.region();
+        let resolution = field.resolution();
+        for (start, goal) in [
+            ([5, 20, 10], [35, 20, 10]),
+            ([5, 5, 5], [35, 35, 15]),
+            ([20, 5, 10], [20, 35, 10]),
+            ([8, 19, 4], [33, 21, 16]),
+        ] {
+            let (start, goal) = (
+                VoxelKey::new(start[0], start[1], start[2]),
+                VoxelKey::new(goal[0], goal[1], goal[2]),
+            );
+            let path = plan_in_field(&field, start, goal).unwrap();
+            assert_eq!(resolution.key_of(&path.waypoints[0]).unwrap(), start);
+            for w in path.waypoints.windows(3) {
+                let k: Vec<VoxelKey> = w.iter().map(|p| resolution.key_of(p).unwrap()).collect();
+                assert!(
+                    !lies_between(k[0], k[1], k[2]),
+                    "redundant waypoint in {:?}",
+                    path.waypoints
+                );
+                assert!(k.iter().all(|key| region.index_of(*key).is_some()));
+            }
+        }
+    }
 }

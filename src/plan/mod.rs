@@ -12,7 +12,8 @@
 //!    `length × (1 + k (1 - S))` plus a clearance penalty.
 //! 4. [`VoxelGraph`] exposes the field through petgraph's graph traits (no graph is built), so
 //!    petgraph's own `astar` and `dijkstra` run on it; [`plan_path`] runs a dense-array A* with a
-//!    consistent heuristic over the same graph, then shortcuts the path by line of sight. A start or goal it may not enter is refused with a
+//!    consistent heuristic over the same graph, then shortcuts the path by line of sight and
+//!    merges collinear waypoints. A start or goal it may not enter is refused with a
 //!    [`Blocker`] that says why and which setting would change it.
 
 mod astar;
