@@ -396,6 +396,58 @@ fn plan_refuses_bad_maps_points_and_parameters() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn unknown_cost_needs_unknown_cost_policy() {
+    let dir = scratch("unknown-cost");
+    let map = saved_map(&dir);
+    let plan = [
+        "plan",
+        "--map",
+        map.as_str(),
+        "--from",
+        "0,0,0.5",
+        "--to",
+        "2,0,0.5",
+    ];
+    let expected = "--unknown-cost only applies with `--unknown cost`";
+    // Given alone or with unknown space forbidden, the cost would be ignored: a usage error.
+    for extra in [
+        &["--unknown-cost", "3"][..],
+        &["--unknown", "forbid", "--unknown-cost", "3"],
+    ] {
+        let args: Vec<&str> = plan.iter().chain(extra).copied().collect();
+        fails(&args, 2, expected);
+    }
+    // eval has the same pair of options and the same rule (checked before any work).
+    fails(
+        &[
+            "eval",
+            "--scenario",
+            "wall",
+            "--plan",
+            "3",
+            "--unknown-cost",
+            "3",
+        ],
+        2,
+        expected,
+    );
+    // With `--unknown cost` the cost is taken, with or without `--unknown-cost`.
+    for extra in [
+        &["--unknown", "cost"][..],
+        &["--unknown", "cost", "--unknown-cost", "3"],
+    ] {
+        let args: Vec<&str> = plan.iter().chain(extra).copied().collect();
+        let out = fuzzyvox(&args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 // ---------------------------------------------------------------------------------------------
 // stereo
 // ---------------------------------------------------------------------------------------------

@@ -54,9 +54,9 @@ pub struct EvalArgs {
     /// allowed at a cost (optimistic exploration).
     #[arg(long, value_enum, default_value_t = Unknown::Forbid)]
     unknown: Unknown,
-    /// Extra cost per metre through unknown space (with `--unknown cost`).
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
-    unknown_cost: f32,
+    /// Extra cost per metre through unknown space; only with `--unknown cost` [default: 5].
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    unknown_cost: Option<f32>,
     /// Write metrics.json, report.md, every map (.fvx) and the figures (PNG) here.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -136,6 +136,10 @@ pub fn run_with_bar(
 }
 
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    let unknown = args
+        .unknown
+        .policy(args.unknown_cost)
+        .unwrap_or_else(|e| e.exit());
     if args.pairs == 0 {
         anyhow::bail!("--pairs must be at least 1");
     }
@@ -146,12 +150,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         .collect::<anyhow::Result<Vec<_>>>()?;
     let scenario = args.scenario.build(args.pairs, args.seed)?;
     let mut config = experiment_config(
-        &scenario,
-        args.res,
-        operators,
-        args.seed,
-        args.plan,
-        args.unknown.policy(args.unknown_cost),
+        &scenario, args.res, operators, args.seed, args.plan, unknown,
     );
     config.views = args.views as usize;
     config.weigh_reused_views = !args.unweighted_views;

@@ -30,9 +30,9 @@ pub struct PlanArgs {
     /// Unknown space: forbidden, or allowed at a cost.
     #[arg(long, value_enum, default_value_t = Unknown::Forbid)]
     unknown: Unknown,
-    /// Extra cost per metre through unknown space (with `--unknown cost`).
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
-    unknown_cost: f32,
+    /// Extra cost per metre through unknown space; only with `--unknown cost` [default: 5].
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    unknown_cost: Option<f32>,
     /// Lowest safety a voxel may have to be entered.
     #[arg(long, default_value_t = 0.2, allow_negative_numbers = true)]
     safety: f32,
@@ -49,17 +49,32 @@ pub enum Unknown {
     Cost,
 }
 
+/// Extra cost per metre through unknown space when `--unknown cost` comes without
+/// `--unknown-cost`.
+pub const DEFAULT_UNKNOWN_COST: f32 = 5.0;
+
 impl Unknown {
-    /// The planner's policy, with `cost` per metre through unknown space.
-    pub fn policy(self, cost: f32) -> UnknownPolicy {
-        match self {
-            Self::Forbid => UnknownPolicy::Forbid,
-            Self::Cost => UnknownPolicy::Cost(cost),
+    /// The planner's policy from `--unknown` and `--unknown-cost`. A cost given while unknown
+    /// space is forbidden is a usage error rather than silently ignored: whoever typed it
+    /// expected the planner to enter unknown space.
+    pub fn policy(self, cost: Option<f32>) -> Result<UnknownPolicy, clap::Error> {
+        match (self, cost) {
+            (Self::Forbid, None) => Ok(UnknownPolicy::Forbid),
+            (Self::Forbid, Some(_)) => Err(clap::Error::raw(
+                clap::error::ErrorKind::ArgumentConflict,
+                "--unknown-cost only applies with `--unknown cost` (unknown space is forbidden \
+                 by default); add `--unknown cost` or drop `--unknown-cost`\n",
+            )),
+            (Self::Cost, cost) => Ok(UnknownPolicy::Cost(cost.unwrap_or(DEFAULT_UNKNOWN_COST))),
         }
     }
 }
 
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
+    let unknown = args
+        .unknown
+        .policy(args.unknown_cost)
+        .unwrap_or_else(|e| e.exit());
     let spinner = super::progress::spinner("loading the map", args.json);
     let map = AnyMap::load(&args.map)?;
     tracing::info!(
@@ -72,7 +87,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let config = PlannerConfig {
         vehicle_radius: args.radius,
         safety_threshold: args.safety,
-        unknown: args.unknown.policy(args.unknown_cost),
+        unknown,
         ..PlannerConfig::default()
     };
     let started = Instant::now();
