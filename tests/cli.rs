@@ -174,11 +174,10 @@ fn insert_reads_octomap_scan_graphs_and_alpha_refuses_them() {
     assert!(String::from_utf8_lossy(&alpha.stderr).contains("needs a confidence per point"));
 }
 
-#[test]
-fn plan_through_a_saved_map() {
-    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-plan-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    // A 6 × 4 m wall 3 m ahead of the sensor.
+/// A fuzzy map of a 6 × 4 m wall 3 m ahead of a sensor at (0, 0, 0.5), saved in `dir`; its
+/// observed extent is [0, -3, -1.5] to [3.1, 3.1, 2.6] m.
+fn wall_map(dir: &std::path::Path) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
     let cloud = dir.join("wall.xyz");
     let mut text = String::new();
     for i in 0..=120 {
@@ -201,6 +200,13 @@ fn plan_through_a_saved_map() {
         map.to_str().unwrap(),
         "--json",
     ]));
+    map
+}
+
+#[test]
+fn plan_through_a_saved_map() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-plan-{}", std::process::id()));
+    let map = wall_map(&dir);
     let plan = json(&fuzzyvox(&[
         "plan",
         "--map",
@@ -229,6 +235,171 @@ fn plan_through_a_saved_map() {
     ]);
     assert!(!behind.status.success());
     assert!(String::from_utf8_lossy(&behind.stderr).contains("goal is not safe"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs `fuzzyvox plan` on `map` from 1.5, 0, 0.5 with `extra` arguments; expects a failure
+/// with exit status 1 and returns standard error.
+fn plan_failure(map: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "plan",
+        "--map",
+        map.to_str().unwrap(),
+        "--from",
+        "1.5,0,0.5",
+    ];
+    args.extend_from_slice(extra);
+    let out = fuzzyvox(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    stderr
+}
+
+#[test]
+fn plan_failures_say_what_blocks_and_which_option_helps() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-why-{}", std::process::id()));
+    let map = wall_map(&dir);
+    let cases: [(&[&str], &[&str]); 6] = [
+        // Behind the wall: outside everything the scan observed.
+        (
+            &["--to", "4,0,0.5"],
+            &[
+                "goal is not safe",
+                "outside the map's observed extent [0.00, -3.00, -1.50] to [3.10, 3.10, 2.60] m",
+                "hint: try a --to inside that extent, or `--unknown cost`",
+            ],
+        ),
+        // Beside the sensor, outside the scan's cone but inside the extent.
+        (
+            &["--to", "0.5,2.5,0.5"],
+            &["its voxel is unknown", "hint: try `--unknown cost`"],
+        ),
+        (
+            &["--to", "3.05,0,0.5"],
+            &["its voxel is occupied", "hint: try another --to"],
+        ),
+        // One free observation gives safety 0.36.
+        (
+            &["--to", "2.5,0.3,0.6", "--safety", "0.9"],
+            &[
+                "start is not safe",
+                "safety 0.36 is below the threshold 0.90",
+                "hint: try `--safety 0.36` or lower",
+            ],
+        ),
+        // 0.3 m from the wall; a 0.3 m vehicle needs 0.3 + √3 × 0.1 m.
+        (
+            &["--to", "2.75,0,0.5"],
+            &[
+                "nearest blocked voxel (occupied, centre 3.05, 0.05, 0.55) is 0.30 m away",
+                "needs 0.47 m",
+                "hint: try `--radius 0.12` or smaller",
+            ],
+        ),
+        // Right against the wall no radius fits.
+        (
+            &["--to", "2.95,0,0.5"],
+            &[
+                "no vehicle radius would fit",
+                "a --to farther from the blocked voxel",
+            ],
+        ),
+    ];
+    for (extra, expected) in cases {
+        let stderr = plan_failure(&map, extra);
+        for text in expected {
+            assert!(stderr.contains(text), "{extra:?}: `{text}` not in {stderr}");
+        }
+    }
+    // The suggested radius and threshold work when typed back.
+    for extra in [
+        &["--to", "2.75,0,0.5", "--radius", "0.12"][..],
+        &["--to", "2.5,0.3,0.6", "--safety", "0.36"],
+    ] {
+        let mut args = vec![
+            "plan",
+            "--map",
+            map.to_str().unwrap(),
+            "--from",
+            "1.5,0,0.5",
+        ];
+        args.extend_from_slice(extra);
+        args.push("--json");
+        assert!(
+            !json(&fuzzyvox(&args))["waypoints"]
+                .as_array()
+                .unwrap()
+                .is_empty()
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn plan_json_failure_prints_the_reason() {
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-whyjson-{}", std::process::id()));
+    let map = wall_map(&dir);
+    for (to, failure, kind) in [
+        ("4,0,0.5", "goal_unsafe", "outside_observed_extent"),
+        ("2.75,0,0.5", "goal_unsafe", "too_close"),
+    ] {
+        let out = fuzzyvox(&[
+            "plan",
+            "--map",
+            map.to_str().unwrap(),
+            "--from",
+            "1.5,0,0.5",
+            "--to",
+            to,
+            "--json",
+        ]);
+        assert_eq!(out.status.code(), Some(1));
+        let report: serde_json::Value =
+            serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+        assert_eq!(report["failure"], failure);
+        assert_eq!(report["reason"]["kind"], kind);
+        assert_eq!(report["model"], "fuzzy");
+        assert!(report["map"].as_str().unwrap().ends_with("wall.fvx"));
+        assert!(
+            report["error"]
+                .as_str()
+                .unwrap()
+                .contains("goal is not safe")
+        );
+        assert!(report["hint"].is_string());
+        assert!(report.get("waypoints").is_none());
+        // The message goes to standard error too, as for every failure.
+        assert!(String::from_utf8_lossy(&out.stderr).contains("goal is not safe"));
+    }
+    let out = fuzzyvox(&[
+        "plan",
+        "--map",
+        map.to_str().unwrap(),
+        "--from",
+        "1.5,0,0.5",
+        "--to",
+        "4,0,0.5",
+        "--json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let extent = &report["reason"]["extent"];
+    assert_eq!(extent["min"].as_array().unwrap().len(), 3);
+    assert!((extent["max"][0].as_f64().unwrap() - 3.1).abs() < 1e-9);
+    let close = fuzzyvox(&[
+        "plan",
+        "--map",
+        map.to_str().unwrap(),
+        "--from",
+        "1.5,0,0.5",
+        "--to",
+        "2.75,0,0.5",
+        "--json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&close.stdout).unwrap();
+    let reason = &report["reason"];
+    assert_eq!(reason["nearest"]["class"], "occupied");
+    assert!((reason["clearance"].as_f64().unwrap() - 0.3).abs() < 1e-6);
+    assert!((reason["vehicle_radius"].as_f64().unwrap() - 0.3).abs() < 1e-9);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

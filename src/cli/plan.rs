@@ -3,7 +3,8 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use fuzzyvox::AnyMap;
-use fuzzyvox::plan::{PlannerConfig, UnknownPolicy, plan_path};
+use fuzzyvox::VoxelClass;
+use fuzzyvox::plan::{Blocker, PlanError, PlannerConfig, UnknownPolicy, plan_path};
 use serde_json::json;
 
 /// Plan a safe flight through a saved map with A*.
@@ -91,9 +92,31 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         ..PlannerConfig::default()
     };
     let started = Instant::now();
-    let path = plan_path(map.as_map(), &args.from, &args.to, &config)?;
+    let result = plan_path(map.as_map(), &args.from, &args.to, &config);
     let seconds = started.elapsed().as_secs_f64();
     spinner.finish_and_clear();
+    let path = match result {
+        Ok(path) => path,
+        Err(error) => {
+            let hint = hint(&error, &config);
+            if args.json {
+                // A script gets the reason on standard output too, next to the exit status.
+                super::print_json(&json!({
+                    "map": args.map,
+                    "model": map.kind().name(),
+                    "error": error.to_string(),
+                    "failure": failure_name(&error),
+                    "reason": error.blocker(),
+                    "hint": hint,
+                    "plan_seconds": seconds,
+                }))?;
+            }
+            return Err(match hint {
+                Some(hint) => anyhow::anyhow!("{error}\n  hint: try {hint}"),
+                None => error.into(),
+            });
+        }
+    };
     if args.json {
         let waypoints: Vec<[f64; 3]> = path.waypoints.iter().map(|p| [p.x, p.y, p.z]).collect();
         return super::print_json(&json!({
@@ -121,4 +144,64 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         println!("  {:.2}, {:.2}, {:.2}", p.x, p.y, p.z);
     }
     Ok(())
+}
+
+/// A stable name for the kind of failure, for JSON output.
+fn failure_name(error: &PlanError) -> &'static str {
+    match error {
+        PlanError::OutOfRegion(_) => "out_of_region",
+        PlanError::StartUnsafe(_) => "start_unsafe",
+        PlanError::GoalUnsafe(_) => "goal_unsafe",
+        PlanError::Disconnected { .. } => "disconnected",
+        PlanError::Map(_) => "invalid_request",
+    }
+}
+
+/// Which command-line options would change a failed plan, if any (printed after `hint: try`):
+/// the library says what blocks the start or goal and which setting would help, this names
+/// the flag and its value.
+fn hint(error: &PlanError, config: &PlannerConfig) -> Option<String> {
+    let unknown_forbidden = config.unknown == UnknownPolicy::Forbid;
+    let (flag, blocker) = match error {
+        PlanError::StartUnsafe(why) => ("--from", why),
+        PlanError::GoalUnsafe(why) => ("--to", why),
+        PlanError::Disconnected { .. } => {
+            let mut hint = String::from("a smaller `--radius` (fits through narrower gaps)");
+            if unknown_forbidden {
+                hint.push_str(", or `--unknown cost` (lets the path cross unknown space)");
+            }
+            return Some(hint);
+        }
+        _ => return None,
+    };
+    Some(match blocker {
+        Blocker::OutsideObservedExtent { .. } => {
+            format!("a {flag} inside that extent, or `--unknown cost`")
+        }
+        Blocker::Unknown => "`--unknown cost`".into(),
+        Blocker::Occupied { .. } | Blocker::Ambiguous { .. } => {
+            format!("another {flag}: no option lets the planner enter such a voxel")
+        }
+        Blocker::LowSafety { .. } => format!(
+            "`--safety {:.2}` or lower",
+            blocker.safety_to_accept().unwrap_or(0.0)
+        ),
+        Blocker::TooClose { nearest, .. } => {
+            let mut options = Vec::new();
+            if let Some(radius) = blocker.radius_to_fit() {
+                options.push(format!("`--radius {radius:.2}` or smaller"));
+            }
+            if nearest.is_some_and(|n| n.class == VoxelClass::Unknown) && unknown_forbidden {
+                options.push("`--unknown cost` (the blocked voxel is unknown)".into());
+            }
+            if let Some(safety) = blocker.safety_to_accept() {
+                options.push(format!(
+                    "`--safety {safety:.2}` or lower (the blocked voxel is free but not safe enough)"
+                ));
+            }
+            options.push(format!("a {flag} farther from the blocked voxel"));
+            options.join(", or ")
+        }
+        _ => return None,
+    })
 }

@@ -193,12 +193,11 @@ impl NearestBlocked {
 impl fmt::Display for Blocker {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::OutsideObservedExtent { point, extent } => write!(
+            Self::OutsideObservedExtent { extent, .. } => write!(
                 f,
-                "{:.2}, {:.2}, {:.2} lies outside the map's observed extent {extent}, where \
-                 the map knows nothing and unknown space is forbidden; choose a point inside \
-                 that extent or allow unknown space at a cost",
-                point.x, point.y, point.z
+                "it lies outside the map's observed extent {extent}, where the map knows \
+                 nothing and unknown space is forbidden; choose a point inside that extent or \
+                 allow unknown space at a cost"
             ),
             Self::Unknown => write!(
                 f,
