@@ -270,20 +270,25 @@ fn shortcut(field: &CostField, voxels: &[VoxelKey]) -> Vec<VoxelKey> {
     kept
 }
 
-/// Drops every interior waypoint that lies on the straight segment between its neighbours
-/// (within a thousandth of a voxel), so that a path has no redundant corners. Shortcutting
-/// leaves such points when the voxel walk of the longer segment breaks a tie differently; the
-/// merged segment is walked again and kept only when it crosses traversable voxels alone, so
-/// the clearance guarantee of the field holds for the merged path too.
+/// Drops every interior waypoint that lies on the segment between its neighbours, so that a
+/// path has no redundant corners. Shortcutting leaves such points when the voxel walk of the
+/// longer segment breaks a tie at a voxel edge differently from the two shorter ones.
+///
+/// A waypoint exactly on the segment is always dropped: the path is the same curve, so it keeps
+/// the field's clearance guarantee. One within a thousandth of a voxel of it (possible only on
+/// segments over a thousand voxels long) is dropped when the merged segment crosses
+/// traversable voxels alone.
 fn merge_collinear(field: &CostField, corners: &[VoxelKey]) -> Vec<VoxelKey> {
     let mut kept: Vec<VoxelKey> = Vec::with_capacity(corners.len());
     for (i, &key) in corners.iter().enumerate() {
-        let next = corners.get(i + 1);
-        let redundant = match (kept.last(), next) {
-            (Some(&before), Some(&after)) => {
-                lies_between(before, key, after)
-                    && segment_voxels(field, before, after, |i| field.is_traversable(i))
-            }
+        let redundant = match (kept.last(), corners.get(i + 1)) {
+            (Some(&before), Some(&after)) => match offset_from_segment(before, key, after) {
+                Some(0.0) => true,
+                Some(offset) if offset <= 1e-3 => {
+                    segment_voxels(field, before, after, |i| field.is_traversable(i))
+                }
+                _ => false,
+            },
             _ => false,
         };
         if !redundant {
@@ -293,25 +298,33 @@ fn merge_collinear(field: &CostField, corners: &[VoxelKey]) -> Vec<VoxelKey> {
     kept
 }
 
-/// Whether `middle` lies on the segment from `a` to `b` (within a thousandth of a voxel of
-/// the line, and between the two ends), so that dropping it leaves the path's shape and length
-/// unchanged. A point beyond an end would be a reversal, whose removal would cut a corner.
-fn lies_between(a: VoxelKey, middle: VoxelKey, b: VoxelKey) -> bool {
+/// Distance in voxels from `middle` to the line through `a` and `b`, or `None` when `middle`
+/// does not lie between the two ends (a reversal, whose removal would cut a corner) or the
+/// ends coincide. Exact (0.0) for a point on the segment: the cross product of integer keys
+/// is computed in integers.
+fn offset_from_segment(a: VoxelKey, middle: VoxelKey, b: VoxelKey) -> Option<f64> {
     let vector = |from: VoxelKey, to: VoxelKey| {
-        nalgebra::Vector3::new(
-            f64::from(to.x) - f64::from(from.x),
-            f64::from(to.y) - f64::from(from.y),
-            f64::from(to.z) - f64::from(from.z),
-        )
+        [
+            i128::from(to.x) - i128::from(from.x),
+            i128::from(to.y) - i128::from(from.y),
+            i128::from(to.z) - i128::from(from.z),
+        ]
     };
-    let (along, to_middle) = (vector(a, b), vector(a, middle));
-    let length = along.norm();
-    if length == 0.0 {
-        return false;
+    let (u, v) = (vector(a, b), vector(a, middle));
+    let dot = |p: [i128; 3], q: [i128; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    let cross = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let (length2, along) = (dot(u, u), dot(u, v));
+    if length2 == 0 || along < 0 || along > length2 {
+        return None;
     }
-    let off_line = along.cross(&to_middle).norm() / length;
-    let t = along.dot(&to_middle) / (length * length);
-    off_line <= 1e-3 && (0.0..=1.0).contains(&t)
+    // Squared in floating point: the cross product's components fit i128, their squares may
+    // not, and a zero product stays exactly zero.
+    let off = cross.map(|c| c as f64);
+    Some(((off[0] * off[0] + off[1] * off[1] + off[2] * off[2]) / (length2 as f64)).sqrt())
 }
 
 #[cfg(test)]
@@ -394,12 +407,27 @@ mod tests {
     }
 
     #[test]
-    fn points_within_a_thousandth_of_a_voxel_are_on_the_line() {
-        let (a, b) = (VoxelKey::new(0, 0, 0), VoxelKey::new(10_000, 1, 0));
+    fn offsets_from_a_segment_are_exact_on_it_and_none_beyond_its_ends() {
+        let key = VoxelKey::new;
+        let (a, b) = (key(0, 0, 0), key(10_000, 1, 0));
+        assert_eq!(
+            offset_from_segment(a, key(20_000, 2, 0), key(40_000, 4, 0)),
+            Some(0.0)
+        );
         // (5, 0, 0) is 0.0005 voxel off the line from a to b; (5000, 0, 0) is 0.5 off.
-        assert!(lies_between(a, VoxelKey::new(5, 0, 0), b));
-        assert!(!lies_between(a, VoxelKey::new(5000, 0, 0), b));
-        assert!(!lies_between(a, a, a));
+        let near = offset_from_segment(a, key(5, 0, 0), b).unwrap();
+        assert!((near - 5e-4).abs() < 1e-9, "{near}");
+        let far = offset_from_segment(a, key(5000, 0, 0), b).unwrap();
+        assert!((far - 0.5).abs() < 1e-6, "{far}");
+        assert_eq!(offset_from_segment(a, key(-1, 0, 0), b), None);
+        assert_eq!(offset_from_segment(a, key(10_001, 1, 0), b), None);
+        assert_eq!(offset_from_segment(a, a, a), None);
+        // Keys at the ends of the key range do not overflow.
+        let (lo, hi) = (key(i32::MIN, i32::MIN, 0), key(i32::MAX, i32::MAX, 0));
+        assert_eq!(
+            offset_from_segment(lo, key(0, 0, 0), hi).map(|d| d < 1.0),
+            Some(true)
+        );
     }
 
     #[test]
@@ -421,8 +449,9 @@ mod tests {
             assert_eq!(resolution.key_of(&path.waypoints[0]).unwrap(), start);
             for w in path.waypoints.windows(3) {
                 let k: Vec<VoxelKey> = w.iter().map(|p| resolution.key_of(p).unwrap()).collect();
-                assert!(
-                    !lies_between(k[0], k[1], k[2]),
+                assert_ne!(
+                    offset_from_segment(k[0], k[1], k[2]),
+                    Some(0.0),
                     "redundant waypoint in {:?}",
                     path.waypoints
                 );
