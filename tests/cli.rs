@@ -470,3 +470,95 @@ fn stereo_rejects_bad_inputs_without_panicking() {
     assert_eq!(sizes.status.code(), Some(1));
     assert!(!String::from_utf8_lossy(&sizes.stderr).contains("panicked"));
 }
+
+/// The `fuzzyvox plan` examples in a text: lines of the form `fuzzyvox plan ...` or
+/// `cargo run --release -- plan ...` (after an optional `$ ` prompt, without a trailing
+/// `# comment`), skipping synopses (`X,Y,Z`). An example followed by a line that starts with
+/// `error:` is expected to fail with that line's first words.
+fn plan_examples(text: &str) -> Vec<(String, Option<String>)> {
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let mut examples = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let line = line.strip_prefix("$ ").unwrap_or(line);
+        let line = line.replace("cargo run --release -- plan ", "fuzzyvox plan ");
+        if !line.starts_with("fuzzyvox plan ") || line.contains("X,Y,Z") {
+            continue;
+        }
+        let command = line.split(" #").next().unwrap_or(&line).trim().to_string();
+        let error = lines
+            .get(i + 1)
+            .filter(|next| next.starts_with("error:"))
+            .map(|next| next.chars().take(40).collect());
+        examples.push((command, error));
+    }
+    examples
+}
+
+#[test]
+fn printed_plan_examples_work() {
+    let Some(data) = data_dir("printed_plan_examples_work") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-examples-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // The map the examples use, made as the README says.
+    let map = dir.join("scan.fvx");
+    json(&fuzzyvox(&[
+        "insert",
+        "--cloud",
+        data.join("octomap-samples/scan.dat").to_str().unwrap(),
+        "--res",
+        "0.1",
+        "--out",
+        map.to_str().unwrap(),
+        "--json",
+    ]));
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut examples = Vec::new();
+    for doc in ["README.md", "docs/planning.md", "docs/cli.md"] {
+        let found = plan_examples(&std::fs::read_to_string(root.join(doc)).unwrap());
+        assert!(!found.is_empty(), "{doc} has no plan example");
+        examples.extend(found);
+    }
+    for help in [&["--help"][..], &["plan", "--help"]] {
+        let out = fuzzyvox(help);
+        let found = plan_examples(&String::from_utf8_lossy(&out.stdout));
+        assert!(!found.is_empty(), "{help:?} shows no plan example");
+        examples.extend(found);
+    }
+    for (command, error) in examples {
+        let args: Vec<String> = command
+            .split_whitespace()
+            .skip(1)
+            .map(|a| match a {
+                "scan.fvx" => map.to_str().unwrap().to_string(),
+                other => other.to_string(),
+            })
+            .collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = fuzzyvox(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        match error {
+            None => {
+                assert!(out.status.success(), "`{command}` failed: {stderr}");
+                if args.contains(&"--json") {
+                    let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+                    assert!(
+                        plan["waypoints"].as_array().unwrap().len() >= 2,
+                        "{command}"
+                    );
+                } else {
+                    assert!(
+                        String::from_utf8_lossy(&out.stdout).starts_with("path of"),
+                        "{command}"
+                    );
+                }
+            }
+            Some(error) => {
+                assert_eq!(out.status.code(), Some(1), "`{command}`: {stderr}");
+                assert!(stderr.starts_with(&error), "`{command}`: {stderr}");
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -30,7 +30,7 @@ use clap::{Parser, Subcommand};
         fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
         fuzzyvox info scan.fvx\n  \
         fuzzyvox export scan.fvx --png top.png --ply scan.ply --bt scan.bt\n  \
-        fuzzyvox plan --map scan.fvx --from 1,0,0.5 --to 6,3,0.5\n  \
+        fuzzyvox plan --map scan.fvx --from 3,0,0.5 --to 7,-11,0.5\n  \
         fuzzyvox rgbd --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.02\n  \
         fuzzyvox stereo --middlebury ../shared/data/middlebury-motorcycle --json\n\n\
         Every command has --help with its own examples; -v, -vv log more to standard error."

@@ -13,8 +13,12 @@ use serde_json::json;
 /// enough or (unless `--unknown cost`) unknown, and prefers safe, open space.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
-    fuzzyvox plan --map scan.fvx --from 1,0,0.5 --to 6,3,0.5\n  \
-    fuzzyvox plan --map scan.fvx --from 1,0,0.5 --to 6,3,0.5 --radius 0.4 --unknown cost --json")]
+    fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx          # OctoMap's laser scan\n  \
+    fuzzyvox plan --map scan.fvx --from 3,0,0.5 --to 7,-11,0.5         # 11.8 m, bending once in free space\n  \
+    fuzzyvox plan --map scan.fvx --from 3,0,0.5 --to 12,8,0.5 --radius 0.4 --unknown cost --json  # into unknown space, at a cost\n\n\
+    A start or goal the planner refuses is reported with what blocks it (unknown, occupied, \
+    ambiguous, low safety, too close to a blocked voxel, or outside the map's observed extent) \
+    and a hint with the option that would change it.")]
 pub struct PlanArgs {
     /// A map file written by `fuzzyvox insert --out`.
     #[arg(long)]
