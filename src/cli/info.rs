@@ -1,8 +1,9 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use fuzzyvox::AnyMap;
 use fuzzyvox::io::read_header;
-use fuzzyvox::{AnyMap, VoxelKey};
+use fuzzyvox::plan::ObservedExtent;
 use serde_json::json;
 
 /// Describe a saved map: kind, resolution, operator, voxel counts per class, extent and memory.
@@ -24,21 +25,9 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     let view = map.as_map();
     let counts = view.counts();
     let resolution = view.resolution();
-    // The extent of the observed voxels.
-    let bounds = view
-        .cells()
-        .fold(None, |acc: Option<(VoxelKey, VoxelKey)>, (k, _)| {
-            Some(match acc {
-                None => (k, k),
-                Some((lo, hi)) => (
-                    VoxelKey::new(lo.x.min(k.x), lo.y.min(k.y), lo.z.min(k.z)),
-                    VoxelKey::new(hi.x.max(k.x), hi.y.max(k.y), hi.z.max(k.z)),
-                ),
-            })
-        });
-    let corners = bounds.map(|(lo, hi)| {
-        let lo = resolution.corner(lo);
-        let hi = resolution.corner(VoxelKey::new(hi.x + 1, hi.y + 1, hi.z + 1));
+    // The same extent the planner quotes when a start or goal lies outside it.
+    let corners = ObservedExtent::of(view).map(|e| {
+        let (lo, hi) = (e.min, e.max);
         ([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z])
     });
     let operator = header.operator.map(|f| f.to_string());
