@@ -22,6 +22,43 @@ struct RangeBin {
     confidence: f64,
 }
 
+/// Free-space soundness of one group of pixels: how often the true surface lies in front of the
+/// depth up to which the dual evidence model clears (`P- - δ`, and the profile's ends at half
+/// and all of the way to `P0`).
+#[derive(Default)]
+struct Soundness {
+    pixels: usize,
+    without_far: usize,
+    before_near: usize,
+    before_half: usize,
+    before_depth: usize,
+}
+
+impl Soundness {
+    fn add(&mut self, near: f32, depth: f32, far: f32, truth: f32, delta: f32) {
+        self.pixels += 1;
+        self.without_far += usize::from(!far.is_finite());
+        self.before_near += usize::from(truth < near - delta);
+        self.before_half += usize::from(truth < near + 0.5 * (depth - near) - delta);
+        self.before_depth += usize::from(truth < depth - delta);
+    }
+
+    fn row(&self, label: &str) {
+        if self.pixels == 0 {
+            return;
+        }
+        let share = |n: usize| 100.0 * n as f64 / self.pixels as f64;
+        println!(
+            "| {label} | {} | {:.1} % | {:.2} % | {:.2} % | {:.2} % |",
+            self.pixels,
+            share(self.without_far),
+            share(self.before_near),
+            share(self.before_half),
+            share(self.before_depth)
+        );
+    }
+}
+
 fn median(values: &mut [f32]) -> f32 {
     values.sort_by(f32::total_cmp);
     values.get(values.len() / 2).copied().unwrap_or(f32::NAN)
@@ -48,10 +85,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let mut bins: Vec<RangeBin> = RANGE_BINS.iter().map(|_| RangeBin::default()).collect();
     let mut depth_in_sky = 0usize;
+    // Pixels that see a surface within the range, and pixels the depth stage gave a depth.
+    let (mut surface_pixels, mut matched_pixels) = (0usize, 0usize);
     // Per rectified pair: its Q_ABD and the median |disparity error| over its pixels.
     let mut by_quality: Vec<(f64, f32)> = Vec::new();
     // |P0 - truth| on the ground (world z below 0.1 m) and on everything else.
     let (mut ground, mut other_surfaces) = (Vec::new(), Vec::new());
+    // Free-space soundness by how the pair was matched and its Q_ABD.
+    const QUALITY_BINS: [(f64, f64); 4] = [(0.0, 0.3), (0.3, 0.6), (0.6, 0.9), (0.9, 1.01)];
+    let mut soundness: Vec<Soundness> = (0..8).map(|_| Soundness::default()).collect();
+    let delta = 0.5 * 3f32.sqrt() * voxel;
+    // The same by each pixel's own parallax: the sine of the angle between its ray and the
+    // baseline.
+    const SINE_BINS: [f64; 6] = [0.05, 0.1, 0.2, 0.4, 0.7, 1.01];
+    let mut by_sine: Vec<Soundness> = (0..12).map(|_| Soundness::default()).collect();
+    // And by the best match's window cost (a fraction of the largest).
+    const COST_BINS: [f32; 6] = [0.05, 0.1, 0.15, 0.2, 0.3, 1.01];
+    let mut by_cost: Vec<Soundness> = (0..12).map(|_| Soundness::default()).collect();
     for (index, (reference, other)) in scenario.pairs.iter().enumerate() {
         if scenario.phases.iter().any(|(_, r)| r.start == index) {
             window.clear();
@@ -76,16 +126,56 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             f64::from(sky),
         );
         let image = out.image();
+        surface_pixels += truth
+            .depth
+            .iter()
+            .filter(|z| **z <= scenario.max_range as f32)
+            .count();
+        matched_pixels += image.depth().iter().filter(|z| z.is_finite()).count();
         let rectified = result.method == MatchMethod::Rectified;
         let mut disparity_errors = Vec::new();
+        let group = 4 * usize::from(!rectified)
+            + QUALITY_BINS
+                .iter()
+                .position(|(low, high)| (*low..*high).contains(&result.quality))
+                .unwrap_or(0);
         for (i, &z) in image.depth().iter().enumerate() {
             if !z.is_finite() {
                 continue;
             }
-            let Some(&true_z) = truth.depth.get(i).filter(|t| t.is_finite()) else {
+            let true_z = truth.depth.get(i).copied().unwrap_or(f32::INFINITY);
+            soundness[group].add(image.near()[i], z, image.far()[i], true_z, delta);
+            {
+                let (u, v) = (
+                    (i % truth.width as usize) as f64,
+                    (i / truth.width as usize) as f64,
+                );
+                let ray = out.world_from_camera().rotation
+                    * out.intrinsics().back_project(u, v, 1.0).coords;
+                let baseline = other.translation.vector - reference.translation.vector;
+                let sine = ray.cross(&baseline).norm() / (ray.norm() * baseline.norm());
+                let bin = SINE_BINS.iter().position(|&end| sine < end).unwrap_or(5);
+                by_sine[6 * usize::from(!rectified) + bin].add(
+                    image.near()[i],
+                    z,
+                    image.far()[i],
+                    true_z,
+                    delta,
+                );
+                let cost = result.disparity.cost[i];
+                let bin = COST_BINS.iter().position(|&end| cost < end).unwrap_or(5);
+                by_cost[6 * usize::from(!rectified) + bin].add(
+                    image.near()[i],
+                    z,
+                    image.far()[i],
+                    true_z,
+                    delta,
+                );
+            }
+            if !true_z.is_finite() {
                 depth_in_sky += 1;
                 continue;
-            };
+            }
             let Some(bin) = RANGE_BINS.iter().position(|&end| true_z < end) else {
                 continue;
             };
@@ -125,6 +215,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         window.views()
     );
     println!(
+        "pixels seeing a surface within {} m: {surface_pixels}; pixels with a depth: {matched_pixels} ({:.1} %)",
+        scenario.max_range,
+        100.0 * matched_pixels as f64 / surface_pixels.max(1) as f64
+    );
+    println!(
         "| true depth | pixels | |P0 - truth| > voxel | truth outside [P-, P+] | mean width | mean confidence |"
     );
     println!("|---|---|---|---|---|---|");
@@ -155,6 +250,55 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 median(errors)
             );
         }
+    }
+    println!(
+        "\n| matching, pair Q_ABD | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for (group, s) in soundness.iter().enumerate() {
+        let (low, high) = QUALITY_BINS[group % 4];
+        let method = if group < 4 {
+            "rectified"
+        } else {
+            "plane sweep"
+        };
+        s.row(&format!("{method}, {low:.1}–{:.1}", high.min(1.0)));
+    }
+    println!(
+        "\n| matching, pixel parallax sine | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for (group, s) in by_sine.iter().enumerate() {
+        let high = SINE_BINS[group % 6];
+        let low = if group % 6 == 0 {
+            0.0
+        } else {
+            SINE_BINS[group % 6 - 1]
+        };
+        let method = if group < 6 {
+            "rectified"
+        } else {
+            "plane sweep"
+        };
+        s.row(&format!("{method}, {low:.2}–{:.2}", high.min(1.0)));
+    }
+    println!(
+        "\n| matching, best window cost | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for (group, s) in by_cost.iter().enumerate() {
+        let high = COST_BINS[group % 6];
+        let low = if group % 6 == 0 {
+            0.0
+        } else {
+            COST_BINS[group % 6 - 1]
+        };
+        let method = if group < 6 {
+            "rectified"
+        } else {
+            "plane sweep"
+        };
+        s.row(&format!("{method}, {low:.2}–{:.2}", high.min(1.0)));
     }
     println!("\n| pair Q_ABD | rectified pairs | median of their median |disparity error| |");
     println!("|---|---|---|");

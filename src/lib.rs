@@ -62,8 +62,8 @@ pub mod storage;
 pub use error::{Error, FormatError, Result};
 pub use geometry::{PinholeIntrinsics, pose_from_matrix, validate_pose};
 pub use integrate::{
-    DepthFrame, Evidence, EvidenceModel, IntegrationOptions, IntegrationStats, IntervalDepthImage,
-    PointCloud, ScanEvidence,
+    DepthFrame, Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats,
+    IntervalDepthImage, PointCloud, ScanEvidence,
 };
 pub use map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,

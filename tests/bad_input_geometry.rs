@@ -177,22 +177,66 @@ fn an_origin_outside_the_key_range_of_a_fine_map_is_an_error() {
 }
 
 #[test]
-fn zero_confidence_points_change_no_confidence_aware_map() {
-    // Documented: a point of confidence 0 gives no evidence to the fuzzy map and falls in no
-    // cut of the alpha-cut map; the log-odds map ignores confidence by design.
+fn zero_confidence_points_add_no_occupied_evidence_and_unreliable_ones_nothing() {
+    // Documented: a point of confidence 0 gives no occupied evidence to the fuzzy map and falls
+    // in no cut of the alpha-cut map; the log-odds map ignores confidence by design. In the
+    // fuzzy map's dual evidence model such a point still clears its ray when it is reliable
+    // (its reliability defaults to 1); with reliability 0, or in the paper's model, it changes
+    // nothing.
     let doubtful = cloud(vec![
         Point3::new(2.0, 0.5, 0.0),
         Point3::new(-1.0, 2.0, 1.0),
     ])
     .with_confidence(vec![0.0, 0.0])
     .unwrap();
-    let maps: Vec<_> = mapped()
+    let alpha: Vec<_> = mapped()
         .into_iter()
-        .filter(|m| !matches!(m, AnyMap::LogOdds(_)))
+        .filter(|m| matches!(m, AnyMap::Alpha(_)))
         .collect();
-    succeeds_unchanged_in(maps, |map| {
+    succeeds_unchanged_in(alpha, |map| {
         map.integrate_cloud(&doubtful, &Default::default())
     });
+    let unreliable = doubtful.clone().with_reliability(vec![0.0, 0.0]).unwrap();
+    let fuzzy = || {
+        mapped()
+            .into_iter()
+            .filter(|m| matches!(m, AnyMap::Fuzzy(_)))
+            .collect::<Vec<_>>()
+    };
+    succeeds_unchanged_in(fuzzy(), |map| {
+        map.integrate_cloud(&unreliable, &Default::default())
+    });
+    let paper = |map: AnyMap| match map {
+        AnyMap::Fuzzy(m) => {
+            let config = m.config().with_evidence(fuzzyvox::EvidenceModel::paper());
+            let mut fresh = FuzzyMap::new(config).unwrap();
+            fresh.merge(&m).unwrap();
+            AnyMap::Fuzzy(fresh)
+        }
+        other => other,
+    };
+    succeeds_unchanged_in(fuzzy().into_iter().map(paper).collect(), |map| {
+        map.integrate_cloud(&doubtful, &Default::default())
+    });
+    // Reliable, it clears: free memberships rise, occupied ones do not.
+    for mut map in fuzzy() {
+        let before: Vec<_> = map.as_map().cells().collect();
+        map.as_map_mut()
+            .integrate_cloud(&doubtful, &Default::default())
+            .unwrap();
+        let after = map.as_map();
+        assert!(
+            before
+                .iter()
+                .all(|(k, m)| after.memberships_at(*k).occupied == m.occupied)
+        );
+        assert!(
+            after.cells().count() > before.len()
+                || before
+                    .iter()
+                    .any(|(k, m)| after.memberships_at(*k).free > m.free)
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -5,7 +5,8 @@ mod common;
 
 use common::{room_scan, wall_frame};
 use fuzzyvox::{
-    Family, FuzzyConfig, FuzzyMap, IntegrationOptions, Memberships, TConorm, VoxelClass, VoxelMap,
+    EvidenceKind, EvidenceModel, Family, FuzzyConfig, FuzzyMap, IntegrationOptions, Memberships,
+    TConorm, VoxelClass, VoxelMap,
 };
 use nalgebra::Point3;
 
@@ -221,27 +222,53 @@ fn max_range_cuts_rays_and_only_clears() {
 
 #[test]
 fn confidence_weights_evidence_as_fractional_observations() {
-    // Two observations at confidence 0.5 equal one at confidence 1 (probabilistic sum).
+    // Two observations at confidence 0.5 equal one at confidence 1 (probabilistic sum): in the
+    // paper's model for both sets; in the dual model for the occupied set, while free space
+    // follows the reliability (1 for a cloud's points).
     let point = Point3::new(1.05, 0.05, 0.05);
-    let mut half = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
     let weak = fuzzyvox::PointCloud::new(Point3::origin(), vec![point])
         .unwrap()
         .with_confidence(vec![0.5])
         .unwrap();
-    half.integrate_cloud(&weak, &Default::default()).unwrap();
-    half.integrate_cloud(&weak, &Default::default()).unwrap();
-    let mut full = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
     let sure = fuzzyvox::PointCloud::new(Point3::origin(), vec![point]).unwrap();
-    full.integrate_cloud(&sure, &Default::default()).unwrap();
-    assert!(max_difference(&half, &full) < 1e-5);
-    // Confidence zero changes nothing.
-    let mut none = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    for model in [EvidenceModel::paper(), EvidenceModel::dual()] {
+        let config = FuzzyConfig::new(0.1).unwrap().with_evidence(model);
+        let mut half = FuzzyMap::new(config).unwrap();
+        half.integrate_cloud(&weak, &Default::default()).unwrap();
+        half.integrate_cloud(&weak, &Default::default()).unwrap();
+        let mut full = FuzzyMap::new(config).unwrap();
+        full.integrate_cloud(&sure, &Default::default()).unwrap();
+        let end = half.memberships_at_point(&point).unwrap().occupied;
+        assert!((end - full.memberships_at_point(&point).unwrap().occupied).abs() < 1e-5);
+        let path = Point3::new(0.55, 0.05, 0.05);
+        let (twice_half, once_full) = (
+            half.memberships_at_point(&path).unwrap().free,
+            full.memberships_at_point(&path).unwrap().free,
+        );
+        if model.kind == EvidenceKind::Paper {
+            assert!(max_difference(&half, &full) < 1e-5);
+        } else {
+            // Two full-weight passes: more free than one.
+            assert!(twice_half > once_full + 0.1, "{twice_half} {once_full}");
+        }
+    }
+    // Confidence zero: nothing in the paper's model; in the dual model only free space.
     let zero = fuzzyvox::PointCloud::new(Point3::origin(), vec![point])
         .unwrap()
         .with_confidence(vec![0.0])
         .unwrap();
+    let mut none = FuzzyMap::new(
+        FuzzyConfig::new(0.1)
+            .unwrap()
+            .with_evidence(EvidenceModel::paper()),
+    )
+    .unwrap();
     none.integrate_cloud(&zero, &Default::default()).unwrap();
     assert_eq!(none.counts().occupied + none.counts().free, 0);
+    let mut cleared = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
+    cleared.integrate_cloud(&zero, &Default::default()).unwrap();
+    assert_eq!(cleared.counts().occupied, 0);
+    assert!(cleared.counts().free > 0);
 }
 
 #[test]

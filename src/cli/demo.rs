@@ -12,6 +12,7 @@ use fuzzyvox::plan::UnknownPolicy;
 use fuzzyvox::sim::scenario;
 
 use super::eval::{experiment_config, run_with_bar};
+use super::maps::Evidence;
 
 /// The simulated flight demo: a drone's camera maps the paper's two scenes (a wall, then a
 /// random flight over buildings and trees) with the standard log-odds map, the alpha-cut map
@@ -33,6 +34,9 @@ pub struct DemoArgs {
     /// JSON instead of the summary, without progress.
     #[arg(long)]
     json: bool,
+    /// Evidence model of the fuzzy map: `dual` (the default) or `paper`, for comparison.
+    #[arg(long, value_enum, default_value_t = Evidence::Dual)]
+    evidence: Evidence,
 }
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
@@ -59,7 +63,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
                 scenario.pairs.len()
             );
         }
-        let config = experiment_config(
+        let mut config = experiment_config(
             &scenario,
             0.2,
             Vec::new(),
@@ -67,6 +71,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             flights,
             UnknownPolicy::Forbid,
         );
+        config.evidence = args.evidence.model();
         let output = run_with_bar(&scenario, &config, args.json)?;
         let (section, _) = write_experiment(&args.out, &scenario, &output)?;
         report.push_str(&section);

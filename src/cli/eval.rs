@@ -10,6 +10,7 @@ use fuzzyvox::eval::{
 use fuzzyvox::plan::{PlannerConfig, UnknownPolicy};
 use fuzzyvox::sim::scenario::{self, Scenario};
 
+use super::maps::Evidence;
 use super::plan::Unknown;
 
 /// Run one of the paper's scenarios: render every stereo pair, run the depth stage, feed the
@@ -47,6 +48,11 @@ pub struct EvalArgs {
     /// default images that share views count as one pair's worth of evidence each).
     #[arg(long)]
     unweighted_views: bool,
+    /// Evidence model of the fuzzy maps: `dual` (free space weighted by how likely each match
+    /// is right, reaching into the depth interval) or `paper` (free space weighted by the
+    /// confidence, only in front of the interval), for comparison.
+    #[arg(long, value_enum, default_value_t = Evidence::Dual)]
+    evidence: Evidence,
     /// Plan this many random flights in every map and check them against the true scene.
     #[arg(long, default_value_t = 0)]
     plan: usize,
@@ -110,6 +116,7 @@ pub fn experiment_config(
                 unknown,
                 ..PlannerConfig::default()
             },
+            ..FlightConfig::default()
         }),
         sample_pairs,
         ..ExperimentConfig::default()
@@ -154,6 +161,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     );
     config.views = args.views as usize;
     config.weigh_reused_views = !args.unweighted_views;
+    config.evidence = args.evidence.model();
     let started = Instant::now();
     let output = run_with_bar(&scenario, &config, args.json)?;
     let seconds = started.elapsed().as_secs_f64();

@@ -5,7 +5,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use fuzzyvox::{Family, IntegrationOptions, IntegrationStats};
 
-use super::maps::{Model, new_map};
+use super::maps::{Evidence, Model, new_map};
 use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
@@ -39,6 +39,10 @@ pub struct InsertArgs {
     /// dombi:2, hamacher:0.5, yager:2, frank:3, einstein, aczel-alsina:2, schweizer-sklar:-1.
     #[arg(long, default_value = "product")]
     op: String,
+    /// Evidence model of the fuzzy map: `dual` weighs free space by each point's reliability
+    /// (1 for every point of a cloud), `paper` by its confidence.
+    #[arg(long, value_enum, default_value_t = Evidence::Dual)]
+    evidence: Evidence,
     /// Number of confidence cuts of the alpha model.
     #[arg(long, default_value_t = 10)]
     cuts: u32,
@@ -55,7 +59,10 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     if args.model != Model::Fuzzy && args.op != "product" {
         bail!("--op applies to the fuzzy model only");
     }
-    let mut map = new_map(args.model, args.res, family, args.cuts)?;
+    if args.model != Model::Fuzzy && args.evidence != Evidence::Dual {
+        bail!("--evidence applies to the fuzzy model only");
+    }
+    let mut map = new_map(args.model, args.res, family, args.evidence, args.cuts)?;
     let reading = super::progress::spinner("reading the scans", args.json);
     let scans = super::input::read_scans(&args.cloud, args.origin)?;
     reading.finish_and_clear();

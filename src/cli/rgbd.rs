@@ -9,7 +9,7 @@ use fuzzyvox::{AnyMap, Family, IntegrationOptions};
 use serde_json::json;
 use tracing::{debug, info};
 
-use super::maps::{Model, new_map};
+use super::maps::{Evidence, Model, new_map};
 use super::progress;
 
 /// Map a folder of real RGB-D frames and check each map against frames it has not seen.
@@ -130,7 +130,7 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
         .map(|&model| {
             Ok(Entry {
                 model,
-                map: new_map(model, args.res, family, args.cuts)?,
+                map: new_map(model, args.res, family, Evidence::Dual, args.cuts)?,
                 build: Duration::ZERO,
                 predict: Duration::ZERO,
                 errors: DepthErrors::default(),

@@ -96,6 +96,7 @@ pub fn interval_image(
         ("disparity plane", &disparities.disparity),
         ("range_low plane", &disparities.range_low),
         ("range_high plane", &disparities.range_high),
+        ("cost plane", &disparities.cost),
     ] {
         if plane.len() != n {
             return Err(Error::SizeMismatch {
@@ -109,6 +110,7 @@ pub fn interval_image(
     let mut depth = vec![f32::NAN; n];
     let mut far = vec![f32::NAN; n];
     let mut conf = vec![f32::NAN; n];
+    let mut reliability = vec![f32::NAN; n];
     let delta = f64::from(params.method.delta());
     for i in 0..n {
         let d = f64::from(disparities.disparity[i]);
@@ -128,6 +130,7 @@ pub fn interval_image(
         };
         depth[i] = z as f32;
         near[i] = (z_near as f32).min(depth[i]);
+        reliability[i] = match_reliability(disparities.cost[i]);
         if let Some(z_far) = geometry.depth(low).filter(|z| z.is_finite()) {
             far[i] = (z_far as f32).max(depth[i]);
             conf[i] = confidence(z_far - z_near, params.confidence_slope, quality);
@@ -143,7 +146,28 @@ pub fn interval_image(
         depth,
         far,
         conf,
-    )
+    )?
+    .with_reliability(reliability)
+}
+
+/// Window costs (fractions of the largest) up to which a match counts as fully reliable, and
+/// from which it counts as not reliable at all: see [`match_reliability`].
+pub const RELIABLE_COST: (f32, f32) = (0.15, 0.30);
+
+/// How likely a match that passed the matcher's uniqueness and left-right checks is right, for
+/// the dual evidence model's free space: 1 up to a best window cost of 0.15 of the largest,
+/// falling linearly to 0 at 0.30. Measured on the simulator (`examples/sim_depth_error.rs`,
+/// `docs/concepts.md`): the true surface lies in front of `P-` for at most 0.25 % of pixels
+/// below 0.15, but for 25 % (0.20–0.30) and 63 % (above 0.30) of the forward-motion plane
+/// sweep's pixels, where the windows no longer agree (the ground at a grazing angle); it does
+/// not rise as the pair's `Q_ABD` falls, which the interval's width and the confidence already
+/// carry, so the reliability does not use it.
+pub fn match_reliability(cost: f32) -> f32 {
+    let (low, high) = RELIABLE_COST;
+    if cost.is_nan() {
+        return 0.0;
+    }
+    ((high - cost) / (high - low)).clamp(0.0, 1.0)
 }
 
 #[cfg(test)]
@@ -164,6 +188,7 @@ mod tests {
             disparity: d.to_vec(),
             range_low: low.to_vec(),
             range_high: high.to_vec(),
+            cost: vec![0.1; 3],
         }
     }
 
@@ -195,6 +220,34 @@ mod tests {
         let image = interval_image(&m, &g, &curve, 1.0).unwrap();
         assert!((image.near()[0] - 50.0 / 13.0).abs() < 1e-5);
         assert!((image.far()[0] - 50.0 / 7.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn reliability_follows_the_match_cost_not_the_interval() {
+        assert_eq!(match_reliability(0.05), 1.0);
+        assert_eq!(match_reliability(0.15), 1.0);
+        assert!((match_reliability(0.225) - 0.5).abs() < 1e-6);
+        assert_eq!(match_reliability(0.3), 0.0);
+        assert_eq!(match_reliability(0.9), 0.0);
+        assert_eq!(match_reliability(f32::NAN), 0.0);
+        let g = geometry();
+        // Pixel 1's far end lies at infinity: no P+ and no confidence, but a reliability.
+        let image = interval_image(
+            &map(
+                [10.0, 0.5, f32::NAN],
+                [8.0, 0.0, f32::NAN],
+                [12.0, 1.0, f32::NAN],
+            ),
+            &g,
+            &IntervalParams::default(),
+            0.1,
+        )
+        .unwrap();
+        let reliability = image.reliability().unwrap();
+        assert_eq!(reliability[0], 1.0);
+        assert_eq!(reliability[1], 1.0);
+        assert!(image.far()[1].is_nan() && image.confidence()[1] == 0.0);
+        assert!(reliability[2].is_nan());
     }
 
     #[test]

@@ -104,26 +104,36 @@ pub(crate) fn match_census(
     let bands = rayon::current_num_threads().clamp(1, height);
     let band_rows = height.div_ceil(bands);
     let pixels = width * height;
-    let (mut disparity, mut range_low, mut range_high) =
-        (vec![0f32; pixels], vec![0f32; pixels], vec![0f32; pixels]);
-    // Each band fills its own rows of the three planes, so the split into planes runs in
+    let (mut disparity, mut range_low, mut range_high, mut cost) = (
+        vec![0f32; pixels],
+        vec![0f32; pixels],
+        vec![0f32; pixels],
+        vec![0f32; pixels],
+    );
+    // Each band fills its own rows of the four planes, so the split into planes runs in
     // parallel too.
     disparity
         .par_chunks_mut(band_rows * width)
         .zip(range_low.par_chunks_mut(band_rows * width))
         .zip(range_high.par_chunks_mut(band_rows * width))
+        .zip(cost.par_chunks_mut(band_rows * width))
         .enumerate()
-        .for_each(|(band, ((d, low), high))| {
+        .for_each(|(band, (((d, low), high), c))| {
             let y0 = band * band_rows;
             let y1 = (y0 + band_rows).min(height);
-            match_band(&ctx, y0, y1, [d, low, high]);
+            match_band(&ctx, y0, y1, [d, low, high, c]);
         });
+    let largest = (params.window_width * params.window_height * u32::from(CENSUS_MAX_COST)) as f32;
+    for c in &mut cost {
+        *c /= largest;
+    }
     DisparityMap {
         width: width as u32,
         height: height as u32,
         disparity,
         range_low,
         range_high,
+        cost,
     }
 }
 
@@ -173,7 +183,7 @@ struct Band {
 
 /// Matches rows `y0..y1` into `out`: the band's rows of the disparity, range-low and range-high
 /// planes.
-fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 3]) {
+fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 4]) {
     let (w, stride) = (ctx.width, ctx.stride);
     let rows = 2 * ctx.radius_y + 1;
     let mut band = Band {
@@ -193,13 +203,14 @@ fn match_band(ctx: &Context, y0: usize, y1: usize, out: [&mut [f32]; 3]) {
     for slot in 0..rows {
         enter_row(ctx, first + slot as isize, &mut band, slot);
     }
-    let [disparity, low, high] = out;
+    let [disparity, low, high, cost] = out;
     let rows_out = disparity
         .chunks_exact_mut(w)
         .zip(low.chunks_exact_mut(w))
-        .zip(high.chunks_exact_mut(w));
-    for (y, ((disparity, low), high)) in (y0..y1).zip(rows_out) {
-        select_row(ctx, y, &mut band, [disparity, low, high]);
+        .zip(high.chunks_exact_mut(w))
+        .zip(cost.chunks_exact_mut(w));
+    for (y, (((disparity, low), high), cost)) in (y0..y1).zip(rows_out) {
+        select_row(ctx, y, &mut band, [disparity, low, high, cost]);
         if y + 1 < y1 {
             // Slide the window down one row: the row leaving (y - ry, slot (y - y0) mod rows)
             // and the row entering (y + ry + 1) are `rows` apart and share the slot.
@@ -392,7 +403,7 @@ fn enter_full_columns(
 /// Window sums of row `y` from the vertical sums, then per pixel the winner, its checks and the
 /// sub-pixel step, written into `out` (the row of the disparity, range-low and range-high
 /// planes).
-fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 3]) {
+fn select_row(ctx: &Context, y: usize, band: &mut Band, out: [&mut [f32]; 4]) {
     let (w, nd, stride, dmin) = (ctx.width, ctx.disparities, ctx.stride, ctx.min_disparity);
     let Band {
         vertical,
@@ -607,15 +618,17 @@ impl Found {
 }
 
 /// The floats of one row from its integer matches: the parabola's sub-pixel offset (the
-/// vertex through the best sum and its neighbours, within half a pixel) and the three planes,
+/// vertex through the best sum and its neighbours, within half a pixel) and the four planes
+/// (the best sum still unscaled),
 /// `NaN` where no match. One pass over the row, which the compiler vectorises.
-fn finish_row(found: &[Found], out: [&mut [f32]; 3]) {
-    let [disparity, range_low, range_high] = out;
+fn finish_row(found: &[Found], out: [&mut [f32]; 4]) {
+    let [disparity, range_low, range_high, best_cost] = out;
     let planes = disparity
         .iter_mut()
         .zip(range_low.iter_mut())
-        .zip(range_high);
-    for (found, ((disparity, low), high)) in found.iter().zip(planes) {
+        .zip(range_high)
+        .zip(best_cost);
+    for (found, (((disparity, low), high), cost)) in found.iter().zip(planes) {
         let [c0, c1, c2] = found.sums.map(|c| c as f32);
         let curvature = c0 - 2.0 * c1 + c2;
         let offset = if curvature > 0.0 {
@@ -631,6 +644,7 @@ fn finish_row(found: &[Found], out: [&mut [f32]; 3]) {
         };
         *low = if matched { found.low as f32 } else { f32::NAN };
         *high = if matched { found.high as f32 } else { f32::NAN };
+        *cost = if matched { c1 } else { f32::NAN };
     }
 }
 
@@ -692,7 +706,10 @@ mod tests {
             disparity: vec![f32::NAN; n],
             range_low: vec![f32::NAN; n],
             range_high: vec![f32::NAN; n],
+            cost: vec![f32::NAN; n],
         };
+        let largest =
+            (params.window_width * params.window_height * u32::from(CENSUS_MAX_COST)) as f32;
         for y in 0..h {
             let sums: Vec<Vec<i32>> = (0..w)
                 .map(|x| (0..nd).map(|d| sum(x, y, d)).collect())
@@ -762,6 +779,7 @@ mod tests {
                 out.disparity[i] = base + best as f32 + offset;
                 out.range_low[i] = base + low as f32;
                 out.range_high[i] = base + high as f32;
+                out.cost[i] = best_cost as f32 / largest;
             }
         }
         out
@@ -846,6 +864,7 @@ mod tests {
                     assert_eq!(bits(&fast.disparity), bits(&slow.disparity), "{context}");
                     assert_eq!(bits(&fast.range_low), bits(&slow.range_low), "{context}");
                     assert_eq!(bits(&fast.range_high), bits(&slow.range_high), "{context}");
+                    assert_eq!(bits(&fast.cost), bits(&slow.cost), "{context}");
                 }
             }
         }

@@ -24,7 +24,9 @@ pub use census::{
 };
 pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
 pub use gray::GrayImage;
-pub use interval::{IntervalMethod, IntervalParams, confidence, interval_image};
+pub use interval::{
+    IntervalMethod, IntervalParams, RELIABLE_COST, confidence, interval_image, match_reliability,
+};
 pub use matching::match_pair;
 pub use metrics::{Accuracy, evaluate};
 pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};

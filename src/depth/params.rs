@@ -98,6 +98,9 @@ pub struct DisparityMap {
     pub range_low: Vec<f32>,
     /// Highest integer disparity whose cost is within the range tolerance of the best.
     pub range_high: Vec<f32>,
+    /// The best match's window cost as a fraction of the largest possible (0: the windows
+    /// agree in every census bit; about 0.5: unrelated patches); `NaN` = no match.
+    pub cost: Vec<f32>,
 }
 
 impl DisparityMap {

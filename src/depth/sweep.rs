@@ -657,6 +657,7 @@ pub(crate) fn sweep_views(
         disparity: vec![f32::NAN; n],
         range_low: vec![f32::NAN; n],
         range_high: vec![f32::NAN; n],
+        cost: vec![f32::NAN; n],
     };
     let max_cost =
         u32::from(CENSUS_MAX_COST) * COST_SCALE * params.window_width * params.window_height;
@@ -679,6 +680,7 @@ pub(crate) fn sweep_views(
         map.disparity[i] = s.best_plane as f32 + offset;
         map.range_low[i] = s.low as f32;
         map.range_high[i] = s.high as f32;
+        map.cost[i] = f32::from(s.best) / max_cost as f32;
     }
     Ok(map)
 }

@@ -13,7 +13,7 @@ use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
 use crate::depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
 use crate::error::{Error, Result};
-use crate::integrate::{DepthFrame, IntegrationOptions};
+use crate::integrate::{DepthFrame, EvidenceModel, IntegrationOptions, IntervalDepthImage};
 use crate::map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, VoxelMap,
 };
@@ -30,6 +30,11 @@ pub struct ExperimentConfig {
     /// each named `fuzzy:` and its t-conorm's name ([`TConorm`]'s `Display`: `fuzzy:maximum`,
     /// `fuzzy:dombi:2`). Listing one operator twice is an error.
     pub operators: Vec<Family>,
+    /// How the fuzzy maps turn depth into evidence (default: the dual model).
+    pub evidence: EvidenceModel,
+    /// Further fuzzy maps with settings of their own, by name (for ablations: the same depth
+    /// into maps that differ in one setting). A name used twice is an error.
+    pub variants: Vec<(String, FuzzyConfig)>,
     /// The depth stage's settings (its depth range defaults to 1 m .. the scenario's range;
     /// forward-motion pairs go through the plane sweep by default, as the paper feeds every
     /// pair to the maps).
@@ -58,6 +63,8 @@ impl Default for ExperimentConfig {
         Self {
             resolution: 0.2,
             operators: Vec::new(),
+            evidence: EvidenceModel::default(),
+            variants: Vec::new(),
             depth: DepthParams {
                 forward_motion: ForwardMotion::PlaneSweep,
                 ..DepthParams::default()
@@ -104,6 +111,9 @@ pub struct ExperimentOutput {
     pub maps: Vec<(String, AnyMap)>,
     /// The gold-standard map (true depth inserted with the standard method).
     pub gold: AnyMap,
+    /// The ground truth of the planned flights (what the depth images' cameras could see),
+    /// when flights were planned.
+    pub flight_truth: Option<AnyMap>,
     /// The kept depth-stage outputs.
     pub samples: Vec<DepthSample>,
     /// The flights' start/goal pairs.
@@ -135,7 +145,8 @@ pub struct ExperimentReport {
     /// Every map's metrics by name: `logodds`, `alpha`, `fuzzy`, and `fuzzy:OP` with `OP` the
     /// extra operator's t-conorm (`fuzzy:maximum`).
     pub maps: BTreeMap<String, MapReport>,
-    /// Flights planned in the gold-standard map, the reference for path lengths.
+    /// Flights planned in the flights' ground-truth map (the true depth of every depth image's
+    /// camera wherever it sees a surface within range), the reference for path lengths.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub truth_flights: Option<FlightSummary>,
     /// Truly occupied voxels in the observed region.
@@ -165,6 +176,29 @@ impl ExperimentReport {
     }
 }
 
+/// The true depth seen by a depth image's own camera (the rectified reference camera for a
+/// rectified pair): every pixel that sees a surface within the scenario's range, exact. A pixel
+/// that sees the sky, or a surface beyond the range the depth stage searches, gives no depth,
+/// as it gives none to any camera-built map. Inserted into a log-odds map, these frames are the
+/// planned flights' ground truth: the space the cameras saw free.
+fn seen_from(scenario: &Scenario, frame: &DepthFrame) -> Result<DepthFrame> {
+    let truth = render(
+        &scenario.scene,
+        frame.intrinsics(),
+        frame.world_from_camera(),
+        0,
+        scenario.max_range * 4.0,
+    );
+    let range = scenario.max_range as f32;
+    let depth: Vec<f32> = truth
+        .depth
+        .iter()
+        .map(|&z| if z <= range { z } else { f32::NAN })
+        .collect();
+    let image = IntervalDepthImage::from_depth(truth.width, truth.height, &depth, |z| (z, z, 1.0))?;
+    DepthFrame::new(*frame.intrinsics(), *frame.world_from_camera(), image)
+}
+
 /// Runs a scenario: renders every pair, runs the depth stage once per pair, feeds the same
 /// depth frames to every map, and evaluates every map after each phase against the ground
 /// truth (the scene's geometry inside the region the gold standard observed).
@@ -190,7 +224,9 @@ pub fn run_experiment_with_progress(
         ),
         (
             "fuzzy".into(),
-            AnyMap::Fuzzy(FuzzyMap::new(FuzzyConfig::new(config.resolution)?)?),
+            AnyMap::Fuzzy(FuzzyMap::new(
+                FuzzyConfig::new(config.resolution)?.with_evidence(config.evidence),
+            )?),
         ),
     ];
     for family in &config.operators {
@@ -199,8 +235,16 @@ pub fn run_experiment_with_progress(
         if maps.iter().any(|(existing, _)| *existing == name) {
             return Err(Error::Duplicate(format!("the operator {operator}")));
         }
-        let fuzzy = FuzzyConfig::new(config.resolution)?.with_operator(operator);
+        let fuzzy = FuzzyConfig::new(config.resolution)?
+            .with_operator(operator)
+            .with_evidence(config.evidence);
         maps.push((name, AnyMap::Fuzzy(FuzzyMap::new(fuzzy)?)));
+    }
+    for (name, fuzzy) in &config.variants {
+        if maps.iter().any(|(existing, _)| existing == name) {
+            return Err(Error::Duplicate(format!("the map name {name}")));
+        }
+        maps.push((name.clone(), AnyMap::Fuzzy(FuzzyMap::new(*fuzzy)?)));
     }
     let mut seconds = BTreeMap::new();
     let started = Instant::now();
@@ -212,6 +256,12 @@ pub fn run_experiment_with_progress(
         config.resolution,
         scenario.max_range,
     )?;
+    // The flights' ground truth: what the depth images' own cameras could see (filled pair by
+    // pair below).
+    let mut camera_truth = match config.flights {
+        Some(_) => Some(LogOddsMap::new(LogOddsConfig::new(config.resolution)?)?),
+        None => None,
+    };
     let truth = GroundTruth::from_scene(&scenario.scene, &gold);
     seconds.insert("ground_truth".into(), started.elapsed().as_secs_f64());
 
@@ -277,6 +327,9 @@ pub fn run_experiment_with_progress(
                     continue;
                 }
             };
+            if let Some(truth_map) = &mut camera_truth {
+                truth_map.integrate_depth(&seen_from(scenario, &depth_frame)?, &options)?;
+            }
             let t = Instant::now();
             for (_, map) in maps.iter_mut() {
                 map.as_map_mut().integrate_depth(&depth_frame, &options)?;
@@ -299,11 +352,12 @@ pub fn run_experiment_with_progress(
     let (flight_queries_list, flights) = match &config.flights {
         Some(flight_config) => {
             let t = Instant::now();
-            let known: Vec<&dyn VoxelMap> = maps.iter().map(|(_, m)| m.as_map()).collect();
-            let queries = flight_queries(&scenario.scene, &gold, &known, flight_config)?;
+            // Flights are drawn from, and planned in, what the cameras could know of the truth.
+            let truth_map = camera_truth.as_ref().unwrap_or(&gold);
+            let queries = flight_queries(&scenario.scene, truth_map, flight_config)?;
             let mut flights = vec![(
                 "truth".to_string(),
-                fly(&gold, &scenario.scene, &queries, &flight_config.planner),
+                fly(truth_map, &scenario.scene, &queries, &flight_config.planner),
             )];
             for (name, map) in &maps {
                 flights.push((
@@ -359,6 +413,7 @@ pub fn run_experiment_with_progress(
         report,
         maps,
         gold: AnyMap::LogOdds(gold),
+        flight_truth: camera_truth.map(AnyMap::LogOdds),
         samples,
         flight_queries: flight_queries_list,
         flights,

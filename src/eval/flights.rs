@@ -1,17 +1,24 @@
 //! Planned flights checked against the true scene: random start/goal pairs in truly free space,
 //! a path planned in each map, and every path's segments swept by a ball of the vehicle's radius
 //! against the scene's real geometry.
+//!
+//! The queries come from the truth alone (the gold-standard map and the scene), never from the
+//! maps being compared, so every map answers the same queries whichever maps sit beside it, and
+//! a map that knows less than the truth fails the queries it cannot answer, with the reason
+//! counted ([`FailureCounts`]).
 
 use nalgebra::Point3;
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
-use crate::plan::{PlannerConfig, plan_path};
+use crate::plan::{PlanError, PlannerConfig, plan_path};
 use crate::sim::Scene;
 use crate::sim::texture::unit_hash;
+use crate::storage::VoxelKey;
 
 /// How flights are drawn and planned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +33,9 @@ pub struct FlightConfig {
     pub distance: (f64, f64),
     /// Lowest and highest flight altitude of starts and goals, metres.
     pub altitude: (f64, f64),
+    /// Extra distance, metres, beyond the vehicle radius that starts and goals keep from every
+    /// true surface. Default: one voxel diagonal of the 0.2 m maps (0.35 m).
+    pub surface_margin: f64,
 }
 
 impl Default for FlightConfig {
@@ -36,6 +46,7 @@ impl Default for FlightConfig {
             planner: PlannerConfig::default(),
             distance: (6.0, 25.0),
             altitude: (1.0, 20.0),
+            surface_margin: 0.2 * 3f64.sqrt(),
         }
     }
 }
@@ -58,6 +69,67 @@ pub struct FlightOutcome {
     pub length: Option<f64>,
     /// Whether the path's swept ball meets the true geometry.
     pub collides: bool,
+    /// Why the planner found no path; `None` when it found one.
+    pub failure: Option<FlightFailure>,
+}
+
+/// Why a map gave no path for a query.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FlightFailure {
+    /// The start voxel is not safe in the map (blocked, unknown, or too close to either).
+    StartUnsafe,
+    /// The goal voxel is not safe in the map.
+    GoalUnsafe,
+    /// Start and goal are safe but no safe path joins them.
+    Disconnected,
+    /// The start or goal lies outside the region the planner could build.
+    OutOfRegion,
+    /// The planner refused the request for another reason (a map or configuration error).
+    Error,
+}
+
+impl FlightFailure {
+    /// The failure behind a planner error.
+    pub fn of(error: &PlanError) -> Self {
+        match error {
+            PlanError::StartUnsafe { .. } => Self::StartUnsafe,
+            PlanError::GoalUnsafe { .. } => Self::GoalUnsafe,
+            PlanError::Disconnected { .. } => Self::Disconnected,
+            PlanError::OutOfRegion { .. } => Self::OutOfRegion,
+            _ => Self::Error,
+        }
+    }
+}
+
+/// How many queries failed, by reason (`plan_failures` in `metrics.json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct FailureCounts {
+    /// The start was not safe in the map.
+    pub start_unsafe: usize,
+    /// The goal was not safe in the map (and the start was).
+    pub goal_unsafe: usize,
+    /// Both were safe but not connected through safe space.
+    pub disconnected: usize,
+    /// The start or goal lay outside the planning region.
+    pub out_of_region: usize,
+    /// The planner refused the request (a map or configuration error; 0 in a sound run).
+    pub error: usize,
+}
+
+impl FailureCounts {
+    fn count(outcomes: &[FlightOutcome]) -> Self {
+        let mut counts = Self::default();
+        for failure in outcomes.iter().filter_map(|o| o.failure) {
+            *match failure {
+                FlightFailure::StartUnsafe => &mut counts.start_unsafe,
+                FlightFailure::GoalUnsafe => &mut counts.goal_unsafe,
+                FlightFailure::Disconnected => &mut counts.disconnected,
+                FlightFailure::OutOfRegion => &mut counts.out_of_region,
+                FlightFailure::Error => &mut counts.error,
+            } += 1;
+        }
+        counts
+    }
 }
 
 /// Flight figures of one map, as reported in `metrics.json`.
@@ -72,20 +144,24 @@ pub struct FlightSummary {
     /// Mean of this map's path length over the ground-truth map's, over the queries both
     /// solved; `None` when there are none.
     pub path_length_ratio: Option<f64>,
+    /// The failed queries by reason.
+    pub plan_failures: FailureCounts,
 }
 
-/// Draws start/goal pairs among the voxels that are truly free: free in the gold-standard map,
-/// within the altitude band, and at least the vehicle radius plus a voxel diagonal from every
-/// surface; and, so that every planner can start and stop, free in each map of `known_in`
-/// (the maps being compared). Deterministic for a seed; fewer pairs come back when too few
-/// candidates exist.
+/// Draws start/goal pairs from the truth alone, among the voxels that are truly free and seen:
+/// voxels within the altitude band from which the gold-standard map (true depth inserted with
+/// the standard method, so only space the cameras saw) can take off, that is, every voxel within
+/// the planner's required clearance (vehicle radius plus a voxel diagonal, see
+/// [`CostField`](crate::plan::CostField)) is free and safe in it; and at least the vehicle
+/// radius plus [`FlightConfig::surface_margin`] from every true surface. The maps being
+/// compared play no part, so every map answers the same queries. Deterministic for a seed;
+/// fewer pairs come back when too few candidates exist.
 pub fn flight_queries(
     scene: &Scene,
     gold: &dyn VoxelMap,
-    known_in: &[&dyn VoxelMap],
     config: &FlightConfig,
 ) -> Result<Vec<FlightQuery>> {
-    config.planner.validate()?;
+    let planner = config.planner.validate()?;
     let (near, far) = config.distance;
     if !(near.is_finite() && far.is_finite() && near >= 0.0 && far > near) {
         return Err(Error::InvalidParameter {
@@ -94,31 +170,57 @@ pub fn flight_queries(
             expected: "0 <= near < far, finite",
         });
     }
+    if !(config.surface_margin.is_finite() && config.surface_margin >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "surface margin",
+            value: config.surface_margin,
+            expected: "a finite distance >= 0 m",
+        });
+    }
     let resolution = gold.resolution();
-    let margin = config.planner.vehicle_radius + 3f64.sqrt() * resolution.size();
-    let mut candidates: Vec<_> = gold
+    let surface_clearance = planner.vehicle_radius + config.surface_margin;
+    let measures = gold.measure_config();
+    let mut candidates: Vec<VoxelKey> = gold
         .cells()
         .filter(|&(key, m)| {
             let z = resolution.center(key).z;
             z >= config.altitude.0
                 && z <= config.altitude.1
-                && gold.measure_config().classify(m) == VoxelClass::Free
-                && known_in
-                    .iter()
-                    .all(|map| map.class_at(key) == VoxelClass::Free)
+                && measures.classify(m) == VoxelClass::Free
         })
         .map(|(key, _)| key)
         .collect();
     candidates.sort_unstable();
-    let candidates: Vec<Point3<f64>> = candidates
-        .par_iter()
-        .map(|&key| resolution.center(key))
-        .filter(|p| scene.distance_to_surface(p) >= margin)
-        .collect();
     let mut queries = Vec::new();
     if candidates.len() < 2 {
         return Ok(queries);
     }
+    // Every voxel whose centre lies closer than the planner's required clearance.
+    let required = planner.vehicle_radius + 3f64.sqrt() * resolution.size();
+    let reach = (required / resolution.size()).ceil() as i32;
+    let mut ball = Vec::new();
+    for dz in -reach..=reach {
+        for dy in -reach..=reach {
+            for dx in -reach..=reach {
+                let d2 = f64::from(dx * dx + dy * dy + dz * dz) * resolution.size().powi(2);
+                if d2 < required * required {
+                    ball.push((dx, dy, dz));
+                }
+            }
+        }
+    }
+    let safe_in_gold = |key: VoxelKey| {
+        let m = gold.measures_at(key);
+        m.class == VoxelClass::Free && m.safety >= planner.safety_threshold
+    };
+    let mut usable: FxHashMap<VoxelKey, bool> = FxHashMap::default();
+    let mut is_usable = |key: VoxelKey| {
+        *usable.entry(key).or_insert_with(|| {
+            ball.iter().all(|&(dx, dy, dz)| {
+                safe_in_gold(VoxelKey::new(key.x + dx, key.y + dy, key.z + dz))
+            }) && scene.distance_to_surface(&resolution.center(key)) >= surface_clearance
+        })
+    };
     let pick = |n: i64, salt: i64| {
         let u = unit_hash(n, salt, 97, config.seed);
         ((u as f64 * candidates.len() as f64) as usize).min(candidates.len() - 1)
@@ -127,10 +229,10 @@ pub fn flight_queries(
     let attempts = 200 * config.queries as i64 + 1000;
     while queries.len() < config.queries && draw < attempts {
         draw += 1;
-        let from = candidates[pick(draw, 1)];
-        let to = candidates[pick(draw, 2)];
+        let (a, b) = (candidates[pick(draw, 1)], candidates[pick(draw, 2)]);
+        let (from, to) = (resolution.center(a), resolution.center(b));
         let d = (to - from).norm();
-        if d >= near && d <= far {
+        if d >= near && d <= far && is_usable(a) && is_usable(b) {
             queries.push(FlightQuery { from, to });
         }
     }
@@ -162,12 +264,14 @@ pub fn fly(
                     length: Some(path.length),
                     waypoints: Some(path.waypoints),
                     collides,
+                    failure: None,
                 }
             }
-            Err(_) => FlightOutcome {
+            Err(error) => FlightOutcome {
                 waypoints: None,
                 length: None,
                 collides: false,
+                failure: Some(FlightFailure::of(&error)),
             },
         })
         .collect()
@@ -192,6 +296,7 @@ pub fn summarize(outcomes: &[FlightOutcome], reference: &[FlightOutcome]) -> Fli
         plan_collisions: outcomes.iter().filter(|o| o.collides).count(),
         path_length_ratio: (!ratios.is_empty())
             .then(|| ratios.iter().sum::<f64>() / ratios.len() as f64),
+        plan_failures: FailureCounts::count(outcomes),
     }
 }
 
@@ -240,9 +345,9 @@ mod tests {
             altitude: (1.5, 4.0),
             ..FlightConfig::default()
         };
-        let a = flight_queries(&scene, &map, &[&map], &config).unwrap();
+        let a = flight_queries(&scene, &map, &config).unwrap();
         assert_eq!(a.len(), 10);
-        assert_eq!(a, flight_queries(&scene, &map, &[&map], &config).unwrap());
+        assert_eq!(a, flight_queries(&scene, &map, &config).unwrap());
         for q in &a {
             let d = (q.to - q.from).norm();
             assert!((1.0..=3.0).contains(&d));
@@ -252,14 +357,16 @@ mod tests {
             }
         }
         let other = FlightConfig { seed: 2, ..config };
-        assert_ne!(a, flight_queries(&scene, &map, &[], &other).unwrap());
-        // A map that knows nothing leaves no candidates.
+        assert_ne!(a, flight_queries(&scene, &map, &other).unwrap());
+        // A truth that saw nothing leaves no candidates.
         let empty = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap();
-        assert!(
-            flight_queries(&scene, &map, &[&empty], &config)
-                .unwrap()
-                .is_empty()
-        );
+        assert!(flight_queries(&scene, &empty, &config).unwrap().is_empty());
+        // A map that knows nothing answers the same queries, and fails each at its start.
+        let outcomes = fly(&empty, &scene, &a, &config.planner);
+        let summary = summarize(&outcomes, &fly(&map, &scene, &a, &config.planner));
+        assert_eq!(summary.plan_success, 0.0);
+        assert_eq!(summary.plan_failures.start_unsafe, a.len());
+        assert_eq!(summary.plan_failures.goal_unsafe, 0);
     }
 
     #[test]
@@ -295,6 +402,8 @@ mod tests {
         };
         let failed = fly(&map, &scene, &[into], &planner);
         assert!(failed[0].length.is_none() && !failed[0].collides);
+        assert_eq!(failed[0].failure, Some(FlightFailure::GoalUnsafe));
+        assert_eq!(summarize(&failed, &failed).plan_failures.goal_unsafe, 1);
         assert_eq!(summarize(&failed, &failed).path_length_ratio, None);
     }
 }

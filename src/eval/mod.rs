@@ -26,7 +26,8 @@ pub use experiment::{
 };
 pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_image, top_down_png};
 pub use flights::{
-    FlightConfig, FlightOutcome, FlightQuery, FlightSummary, flight_queries, fly, summarize,
+    FailureCounts, FlightConfig, FlightFailure, FlightOutcome, FlightQuery, FlightSummary,
+    flight_queries, fly, summarize,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, write_experiment};

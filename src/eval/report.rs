@@ -102,11 +102,14 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
     if report.maps.values().any(|m| m.flights.is_some()) {
         let _ = writeln!(
             md,
-            "Planned flights: the same random start/goal pairs in truly free space, planned in \
-             each map and checked against the true geometry with the vehicle's radius swept \
-             along every segment. Length ratio: mean path length over the length of the path \
-             planned in the ground-truth (gold-standard) map.\n\n\
-             | map | queries | success | collisions | length ratio |\n|---|---|---|---|---|"
+            "Planned flights: the same random start/goal pairs, drawn from the truth alone \
+             (truly free space that the cameras saw, clear of every surface), planned in each \
+             map and checked against the true geometry with the vehicle's radius swept along \
+             every segment. A map in which the start or goal is not safe fails that query; the \
+             failures are counted by reason. Length ratio: mean path length over the length of \
+             the path planned in the ground-truth (gold-standard) map.\n\n\
+             | map | queries | success | collisions | length ratio | start not safe | goal not \
+             safe | disconnected | outside the region |\n|---|---|---|---|---|---|---|---|---|"
         );
         let rows = report
             .truth_flights
@@ -119,14 +122,19 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
                     .filter_map(|(n, m)| Some((n.clone(), m.flights.as_ref()?))),
             );
         for (map_name, f) in rows {
+            let failed = &f.plan_failures;
             let _ = writeln!(
                 md,
-                "| {map_name} | {} | {:.2} | {} | {} |",
+                "| {map_name} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
                 f.plan_queries,
                 f.plan_success,
                 f.plan_collisions,
                 f.path_length_ratio
-                    .map_or("–".to_string(), |r| format!("{r:.3}"))
+                    .map_or("–".to_string(), |r| format!("{r:.3}")),
+                failed.start_unsafe,
+                failed.goal_unsafe,
+                failed.disconnected,
+                failed.out_of_region + failed.error
             );
         }
         let _ = writeln!(md);

@@ -12,6 +12,7 @@ pub struct PointCloud {
     origin: Point3<f64>,
     points: Vec<Point3<f64>>,
     confidence: Option<Vec<f32>>,
+    reliability: Option<Vec<f32>>,
 }
 
 impl PointCloud {
@@ -27,6 +28,7 @@ impl PointCloud {
             origin,
             points,
             confidence: None,
+            reliability: None,
         })
     }
 
@@ -48,6 +50,45 @@ impl PointCloud {
         }
         self.confidence = Some(confidence);
         Ok(self)
+    }
+
+    /// Adds a reliability per point in `[0, 1]`: how likely the point is right at all, so how
+    /// much its ray's free space can be trusted, whatever its confidence says about where the
+    /// surface is. The dual evidence model ([`EvidenceKind::Dual`](crate::EvidenceKind)) weighs
+    /// free evidence by it (1 for every point without it) and the paper's model by the
+    /// confidence; a point of confidence 0 and reliability above 0 then only clears its ray.
+    ///
+    /// # Errors
+    /// [`Error::SizeMismatch`] for a length other than the number of points,
+    /// [`Error::InvalidConfidence`] for a value outside `[0, 1]` (NaN included).
+    pub fn with_reliability(mut self, reliability: Vec<f32>) -> Result<Self> {
+        if reliability.len() != self.points.len() {
+            return Err(Error::SizeMismatch {
+                what: "reliability per point",
+                expected: self.points.len(),
+                found: reliability.len(),
+            });
+        }
+        if let Some((index, &value)) = reliability
+            .iter()
+            .enumerate()
+            .find(|(_, r)| !(0.0..=1.0).contains(*r))
+        {
+            return Err(Error::InvalidConfidence { index, value });
+        }
+        self.reliability = Some(reliability);
+        Ok(self)
+    }
+
+    /// The reliability per point, when set.
+    pub fn reliability(&self) -> Option<&[f32]> {
+        self.reliability.as_deref()
+    }
+
+    /// Reliability of point `i` (1 when the cloud has none).
+    #[inline]
+    pub fn reliability_of(&self, i: usize) -> f32 {
+        self.reliability.as_ref().map_or(1.0, |r| r[i])
     }
 
     /// The sensor origin.
@@ -96,5 +137,10 @@ mod tests {
         assert!(cloud.clone().with_confidence(vec![0.5, f32::NAN]).is_err());
         let ok = cloud.with_confidence(vec![0.5, 1.0]).unwrap();
         assert_eq!(ok.confidence_of(0), 0.5);
+        assert_eq!(ok.reliability_of(0), 1.0);
+        assert!(ok.clone().with_reliability(vec![0.5]).is_err());
+        assert!(ok.clone().with_reliability(vec![0.5, f32::NAN]).is_err());
+        let ok = ok.with_reliability(vec![0.25, 1.0]).unwrap();
+        assert_eq!(ok.reliability_of(0), 0.25);
     }
 }

@@ -11,6 +11,15 @@ use crate::geometry::{PinholeIntrinsics, validate_pose};
 /// number greater than zero; invalid pixels (NaN, infinite, zero or negative depth, missing
 /// interval, NaN confidence) contribute nothing when integrated. Out-of-order intervals and
 /// confidences outside `[0, 1]` are errors at construction.
+///
+/// An image may also carry a *reliability* per pixel ([`IntervalDepthImage::with_reliability`]):
+/// how likely the measurement is right at all (for a stereo match: that it matched the right
+/// point), as opposed to the confidence, which also says how narrow the interval is. The dual
+/// evidence model ([`EvidenceKind::Dual`](crate::EvidenceKind)) weighs free space by it, and
+/// uses pixels that have a reliability and a sound near bound `P-` even when their far bound
+/// `P+` or their confidence is missing: such a pixel still says that the space in front of
+/// `P-` is empty. Without a reliability plane every valid pixel counts as fully reliable (a
+/// sensor's return, such as an RGB-D camera's).
 #[derive(Clone, Debug, PartialEq)]
 pub struct IntervalDepthImage {
     width: u32,
@@ -19,15 +28,20 @@ pub struct IntervalDepthImage {
     depth: Vec<f32>,
     far: Vec<f32>,
     confidence: Vec<f32>,
+    reliability: Option<Vec<f32>>,
 }
 
-/// One valid pixel's interval.
+/// One pixel's interval, confidence and reliability as an integrator reads them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PixelInterval {
     pub near: f32,
     pub depth: f32,
+    /// `P+`; infinite when the pixel has no far bound (dual model only).
     pub far: f32,
+    /// 0 when the pixel has none (dual model only).
     pub confidence: f32,
+    /// How likely the measurement is right, in `[0, 1]`.
+    pub reliability: f32,
 }
 
 impl IntervalDepthImage {
@@ -65,6 +79,7 @@ impl IntervalDepthImage {
             depth,
             far,
             confidence,
+            reliability: None,
         };
         for i in 0..pixels {
             let c = image.confidence[i];
@@ -119,6 +134,37 @@ impl IntervalDepthImage {
         Self::new(width, height, near, depth.to_vec(), far, confidence)
     }
 
+    /// Adds a reliability plane (row-major, `width × height` values in `[0, 1]`; NaN for a
+    /// pixel without one, which then gives no free evidence): how likely each pixel's
+    /// measurement is right, whatever its interval's width. See the type's documentation.
+    ///
+    /// # Errors
+    /// [`Error::SizeMismatch`] for a plane of the wrong size, [`Error::InvalidConfidence`] for
+    /// a value outside `[0, 1]`.
+    pub fn with_reliability(mut self, reliability: Vec<f32>) -> Result<Self> {
+        if reliability.len() != self.depth.len() {
+            return Err(Error::SizeMismatch {
+                what: "reliability plane",
+                expected: self.depth.len(),
+                found: reliability.len(),
+            });
+        }
+        if let Some((index, &value)) = reliability
+            .iter()
+            .enumerate()
+            .find(|(_, r)| !r.is_nan() && !(0.0..=1.0).contains(*r))
+        {
+            return Err(Error::InvalidConfidence { index, value });
+        }
+        self.reliability = Some(reliability);
+        Ok(self)
+    }
+
+    /// The reliability plane, row-major, when the image has one.
+    pub fn reliability(&self) -> Option<&[f32]> {
+        self.reliability.as_deref()
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width
@@ -156,7 +202,8 @@ impl IntervalDepthImage {
             .count()
     }
 
-    /// The interval of pixel `index` (row-major), when valid.
+    /// The interval of pixel `index` (row-major), when valid (the paper's pixels: all three
+    /// depths and a confidence), with reliability 1 (the paper's model does not read it).
     #[inline]
     pub(crate) fn pixel(&self, index: usize) -> Option<PixelInterval> {
         let p = PixelInterval {
@@ -164,9 +211,41 @@ impl IntervalDepthImage {
             depth: self.depth[index],
             far: self.far[index],
             confidence: self.confidence[index],
+            reliability: 1.0,
         };
         (depth_valid(p.near) && depth_valid(p.depth) && depth_valid(p.far) && p.confidence > 0.0)
             .then_some(p)
+    }
+
+    /// Pixel `index` as the dual evidence model reads it: a sound near bound and depth
+    /// (`P- <= P0`, both valid) and a reliability above zero are enough; a missing far bound
+    /// becomes infinite and a missing confidence 0 (the pixel then only clears free space).
+    /// Without a reliability plane, the valid pixels of [`IntervalDepthImage::pixel`] have
+    /// reliability 1 and the others none.
+    #[inline]
+    pub(crate) fn dual_pixel(&self, index: usize) -> Option<PixelInterval> {
+        let Some(plane) = &self.reliability else {
+            return self.pixel(index);
+        };
+        let reliability = plane[index];
+        let (near, depth) = (self.near[index], self.depth[index]);
+        if !(reliability > 0.0 && depth_valid(near) && depth_valid(depth) && near <= depth) {
+            return None;
+        }
+        let far = self.far[index];
+        let confidence = self.confidence[index];
+        let bounded = depth_valid(far);
+        Some(PixelInterval {
+            near,
+            depth,
+            far: if bounded { far } else { f32::INFINITY },
+            confidence: if bounded && confidence > 0.0 {
+                confidence
+            } else {
+                0.0
+            },
+            reliability,
+        })
     }
 }
 
@@ -221,7 +300,7 @@ impl DepthFrame {
         &self.image
     }
 
-    /// Multiplies every pixel's confidence by `weight` in `(0, 1]`: the frame then counts as
+    /// Multiplies every pixel's confidence (and reliability) by `weight` in `(0, 1]`: the frame then counts as
     /// `weight` of an observation in the maps that weigh evidence by confidence (the fuzzy and
     /// alpha-cut maps; the log-odds map ignores confidence). For depth images that share their
     /// source views with others, see [`DepthResult::reuse_weight`](crate::depth::DepthResult::reuse_weight).
@@ -240,6 +319,27 @@ impl DepthFrame {
         for c in &mut self.image.confidence {
             *c *= weight;
         }
+        // An image without a reliability plane has reliability 1 on its valid pixels: the
+        // scaled frame holds it as a plane of `weight` there.
+        let image = &mut self.image;
+        let plane = match image.reliability.take() {
+            Some(mut plane) => {
+                for r in &mut plane {
+                    *r *= weight;
+                }
+                plane
+            }
+            None => (0..image.depth.len())
+                .map(|i| {
+                    if image.pixel(i).is_some() {
+                        weight
+                    } else {
+                        f32::NAN
+                    }
+                })
+                .collect(),
+        };
+        image.reliability = Some(plane);
         Ok(())
     }
 
@@ -286,6 +386,42 @@ mod tests {
         assert_eq!(ok(-1.0, 2.0, 3.0, 0.5).unwrap().valid_pixels(), 0);
         assert!(IntervalDepthImage::new(2, 1, vec![1.0], vec![1.0], vec![1.0], vec![1.0]).is_err());
         assert!(IntervalDepthImage::new(0, 0, vec![], vec![], vec![], vec![]).is_err());
+    }
+
+    #[test]
+    fn reliability_planes_are_validated_and_read_by_the_dual_model_only() {
+        let image = IntervalDepthImage::new(
+            3,
+            1,
+            vec![1.0, 1.0, 1.0],
+            vec![2.0, 2.0, 2.0],
+            vec![3.0, f32::NAN, 3.0],
+            vec![0.5, f32::NAN, 0.5],
+        )
+        .unwrap();
+        assert!(matches!(
+            image.clone().with_reliability(vec![1.0; 2]),
+            Err(Error::SizeMismatch { .. })
+        ));
+        assert!(matches!(
+            image.clone().with_reliability(vec![1.0, -0.5, 1.0]),
+            Err(Error::InvalidConfidence { index: 1, .. })
+        ));
+        // Without a plane the dual model reads the paper's valid pixels, fully reliable.
+        assert_eq!(image.dual_pixel(0).unwrap().reliability, 1.0);
+        assert!(image.dual_pixel(1).is_none());
+        let image = image.with_reliability(vec![0.8, 0.6, f32::NAN]).unwrap();
+        // A pixel without P+ or confidence: infinite far bound, confidence 0.
+        let p = image.dual_pixel(1).unwrap();
+        assert!(p.far.is_infinite() && p.confidence == 0.0 && p.reliability == 0.6);
+        // NaN reliability: no dual pixel, though the paper's model still reads it.
+        assert!(image.dual_pixel(2).is_none() && image.pixel(2).is_some());
+        assert!(image.pixel(1).is_none());
+        // Scaling a frame's weight scales its reliability too.
+        let k = PinholeIntrinsics::new(3, 1, 1.0, 1.0, 1.0, 0.0).unwrap();
+        let mut frame = DepthFrame::new(k, Isometry3::identity(), image).unwrap();
+        frame.scale_confidence(0.5).unwrap();
+        assert_eq!(frame.image().reliability().unwrap()[0], 0.4);
     }
 
     #[test]

@@ -43,15 +43,45 @@ pub(crate) fn merge_max(mut a: ScanEvidence, b: ScanEvidence) -> ScanEvidence {
     a
 }
 
+/// Which claims of a measurement its free evidence rests on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum EvidenceKind {
+    /// The paper's model: free evidence weighted by the same confidence `c` as occupied
+    /// evidence, and only in front of the interval (a depth image's voxels up to `P- - δ`).
+    /// A pixel without a far bound or a confidence gives nothing.
+    Paper,
+    /// Each set gets the evidence its claim supports (see `docs/concepts.md`): occupied
+    /// evidence keeps the confidence `c`; free evidence is weighted by the measurement's
+    /// *reliability* `r` (how likely the match is right, not how wide its interval is) and,
+    /// for a depth interval, reaches into the interval with a profile `ψ(z)` that falls from 1
+    /// at `P-` to 0 part of the way to `P0` ([`EvidenceModel::free_reach`]). A pixel whose
+    /// `P+` is undefined still clears up to its `P-` when it is reliable. The default.
+    #[default]
+    Dual,
+}
+
+impl EvidenceKind {
+    /// Lower-case name (`paper`, `dual`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Paper => "paper",
+            Self::Dual => "dual",
+        }
+    }
+}
+
 /// How measurements become evidence.
 ///
-/// A measurement of confidence `c` gives free evidence `g⁻¹(c · g(free_gain))` to the voxels it
-/// sees through and occupied evidence `g⁻¹(c · g(occupied_gain · φ))` around its end point, where
-/// `g` is the additive generator of the map's t-conorm (so `c = 0.5` counts as half an
-/// observation) and `φ` in `[0, 1]` is the spatial kernel. For the non-Archimedean maximum the
-/// weighting is `c · μ`.
+/// A measurement of confidence `c` gives occupied evidence `g⁻¹(c · g(occupied_gain · φ))`
+/// around its end point, where `g` is the additive generator of the map's t-conorm (so
+/// `c = 0.5` counts as half an observation) and `φ` in `[0, 1]` is the spatial kernel; for the
+/// non-Archimedean maximum the weighting is `c · μ`. Free evidence to the voxels it sees
+/// through is `g⁻¹(w · g(free_gain))` with `w = c` in the paper's model and `w = r · ψ(z)` in
+/// the dual model ([`EvidenceKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EvidenceModel {
+    /// Which model: the paper's or the dual one.
+    pub kind: EvidenceKind,
     /// Occupied evidence of one certain hit at the kernel's peak (`k_O`, default 0.7).
     pub occupied_gain: f32,
     /// Free evidence of one certain pass-through (`k_E`, default 0.6).
@@ -67,6 +97,12 @@ pub struct EvidenceModel {
     /// 0 ignores the width; in between, wide intervals commit less per voxel yet repeated views
     /// build up faster. Default 1.
     pub interval_falloff: f32,
+    /// Dual model: how far into a depth interval free evidence reaches, as a fraction of
+    /// `P0 - P-`: the profile `ψ` is 1 up to `P-` and falls linearly to 0 at
+    /// `P- + free_reach · (P0 - P-)` (each less `δ`, half a voxel diagonal, so that a voxel
+    /// whose centre is cleared lies wholly in front of the bound). 0 stops at `P-`, as the
+    /// paper's model does. In `[0, 1]`; ignored by the paper's model.
+    pub free_reach: f32,
 }
 
 impl EvidenceModel {
@@ -94,6 +130,13 @@ impl EvidenceModel {
                 expected: "an exponent in [0, 1]",
             });
         }
+        if !(0.0..=1.0).contains(&self.free_reach) {
+            return Err(Error::InvalidParameter {
+                name: "free_reach",
+                value: f64::from(self.free_reach),
+                expected: "a fraction of the interval in [0, 1]",
+            });
+        }
         finite("angular_resolution", self.angular_resolution)?;
         if !(0.0..=0.1).contains(&self.angular_resolution) {
             return Err(Error::InvalidParameter {
@@ -105,10 +148,49 @@ impl EvidenceModel {
         Ok(self)
     }
 
-    /// Free evidence of a measurement with confidence `c`.
+    /// The paper's model, as the first wave built it.
+    pub fn paper() -> Self {
+        Self {
+            kind: EvidenceKind::Paper,
+            occupied_gain: 0.7,
+            free_gain: 0.6,
+            angular_resolution: 0.002,
+            interval_falloff: 1.0,
+            free_reach: 0.0,
+        }
+    }
+
+    /// The dual model (the default).
+    pub fn dual() -> Self {
+        Self {
+            kind: EvidenceKind::Dual,
+            free_reach: 0.5,
+            ..Self::paper()
+        }
+    }
+
+    /// The model of `kind` with its default parameters.
+    pub fn of_kind(kind: EvidenceKind) -> Self {
+        match kind {
+            EvidenceKind::Paper => Self::paper(),
+            EvidenceKind::Dual => Self::dual(),
+        }
+    }
+
+    /// The weight of a measurement's free evidence before any profile: its confidence in the
+    /// paper's model, its reliability in the dual one.
     #[inline]
-    pub fn free(&self, operator: &TConorm, c: f32) -> f32 {
-        operator.weighted(self.free_gain, c)
+    pub fn free_weight(&self, confidence: f32, reliability: f32) -> f32 {
+        match self.kind {
+            EvidenceKind::Paper => confidence,
+            EvidenceKind::Dual => reliability,
+        }
+    }
+
+    /// Free evidence of a measurement of weight `w` (see [`EvidenceModel::free_weight`]).
+    #[inline]
+    pub fn free(&self, operator: &TConorm, w: f32) -> f32 {
+        operator.weighted(self.free_gain, w)
     }
 
     /// Occupied evidence of a measurement with confidence `c` where the kernel is `phi`.
@@ -120,12 +202,7 @@ impl EvidenceModel {
 
 impl Default for EvidenceModel {
     fn default() -> Self {
-        Self {
-            occupied_gain: 0.7,
-            free_gain: 0.6,
-            angular_resolution: 0.002,
-            interval_falloff: 1.0,
-        }
+        Self::dual()
     }
 }
 

@@ -1,9 +1,9 @@
 use nalgebra::{Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
-use super::depth_image::{DepthFrame, PixelInterval};
+use super::depth_image::{DepthFrame, IntervalDepthImage, PixelInterval};
 use super::evidence::{
-    Evidence, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence,
+    Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence,
 };
 use crate::error::{Error, Result};
 use crate::ops::TConorm;
@@ -58,11 +58,7 @@ pub fn depth_evidence(
     // Per pixel: its interval and the evidence that does not depend on the voxel.
     let pixels: Vec<PixelEvidence> = (0..image.depth().len())
         .into_par_iter()
-        .map(|i| {
-            image.pixel(i).map_or(PixelEvidence::NONE, |p| {
-                PixelEvidence::new(p, model, operator, max_range, half_diagonal)
-            })
-        })
+        .map(|i| PixelEvidence::of(image, i, model, operator, max_range, half_diagonal))
         .collect();
     let integrated = pixels.iter().filter(|p| p.is_valid()).count();
     let stats = IntegrationStats {
@@ -70,7 +66,7 @@ pub fn depth_evidence(
         skipped: pixels.len() - integrated,
         clipped: pixels
             .iter()
-            .filter(|p| p.is_valid() && p.height <= 0.0)
+            .filter(|p| p.is_valid() && p.depth > max_range)
             .count(),
         voxels_updated: 0,
     };
@@ -170,34 +166,55 @@ fn mark_end_points(
 #[derive(Clone, Copy)]
 #[repr(C, align(32))]
 struct PixelEvidence {
-    /// Voxels with `z` below this get free evidence.
+    /// Voxels with `z` below this get the full free evidence (`ψ = 1`).
     free_until: f32,
+    /// Voxels with `z` from `free_until` up to this get free evidence graded by the profile
+    /// `ψ` (the dual model; equal to `free_until` in the paper's model).
+    free_end: f32,
     /// Voxels with `z` up to this can get evidence.
     reach: f32,
-    /// `P-`, `P0`, `P+`.
-    near: f32,
+    /// `P0`.
     depth: f32,
-    far: f32,
-    /// Peak of the occupied kernel, `(2δ / (P+ - P- + 2δ))^falloff`; 0 for a pixel beyond the
-    /// maximum range, which only clears.
+    /// Peak of the occupied kernel, `(2δ / (P+ - P- + 2δ))^falloff`; 0 for a pixel that only
+    /// clears (beyond the maximum range, or without a confidence in the dual model).
     height: f32,
-    /// Free evidence for voxels in front of the interval.
+    /// Free evidence where `ψ = 1`.
     free: f32,
-    /// The pixel's confidence.
+    /// Weight of the free evidence before the profile (confidence or reliability).
+    free_weight: f32,
+    /// The pixel's confidence (weight of its occupied evidence).
     confidence: f32,
 }
 
 impl PixelEvidence {
     const NONE: Self = Self {
         free_until: f32::NEG_INFINITY,
+        free_end: f32::NEG_INFINITY,
         reach: f32::NEG_INFINITY,
-        near: 0.0,
         depth: 0.0,
-        far: 0.0,
         height: 0.0,
         free: 0.0,
+        free_weight: 0.0,
         confidence: 0.0,
     };
+
+    /// The pixel's evidence under `model`, or [`PixelEvidence::NONE`] when it gives none.
+    fn of(
+        image: &IntervalDepthImage,
+        index: usize,
+        model: &EvidenceModel,
+        operator: &TConorm,
+        max_range: f32,
+        delta: f32,
+    ) -> Self {
+        let pixel = match model.kind {
+            EvidenceKind::Paper => image.pixel(index),
+            EvidenceKind::Dual => image.dual_pixel(index),
+        };
+        pixel.map_or(Self::NONE, |p| {
+            Self::new(p, model, operator, max_range, delta)
+        })
+    }
 
     fn new(
         interval: PixelInterval,
@@ -207,35 +224,76 @@ impl PixelEvidence {
         delta: f32,
     ) -> Self {
         let beyond_range = interval.depth > max_range;
-        let share = 2.0 * delta / (interval.far - interval.near + 2.0 * delta);
-        let height = match model.interval_falloff {
-            _ if beyond_range => 0.0,
-            1.0 => share,
-            0.0 => 1.0,
-            falloff => share.powf(falloff),
+        let free_weight = model.free_weight(interval.confidence, interval.reliability);
+        let free = model.free(operator, free_weight);
+        if model.kind == EvidenceKind::Paper {
+            let share = 2.0 * delta / (interval.far - interval.near + 2.0 * delta);
+            let height = match model.interval_falloff {
+                _ if beyond_range => 0.0,
+                1.0 => share,
+                0.0 => 1.0,
+                falloff => share.powf(falloff),
+            };
+            let (free_until, reach) = if beyond_range {
+                (max_range, max_range)
+            } else {
+                (interval.near - delta, interval.far + delta)
+            };
+            return Self {
+                free_until,
+                free_end: free_until,
+                reach,
+                depth: interval.depth,
+                height,
+                free,
+                free_weight,
+                confidence: interval.confidence,
+            };
+        }
+        // Dual: ψ = 1 up to P- - δ, then falls linearly to 0 at the reach's end - δ; free
+        // space never goes past the maximum range.
+        let graded_end = interval.near + model.free_reach * (interval.depth - interval.near);
+        let free_until = (interval.near - delta).min(max_range);
+        let free_end = (graded_end - delta).min(max_range).max(free_until);
+        let occupies = !beyond_range && interval.confidence > 0.0 && interval.far.is_finite();
+        let height = if occupies {
+            let share = 2.0 * delta / (interval.far - interval.near + 2.0 * delta);
+            match model.interval_falloff {
+                1.0 => share,
+                0.0 => 1.0,
+                falloff => share.powf(falloff),
+            }
+        } else {
+            0.0
         };
         Self {
-            free_until: if beyond_range {
-                max_range
+            free_until,
+            free_end,
+            reach: if occupies {
+                (interval.far + delta).max(free_end)
             } else {
-                interval.near - delta
+                free_end
             },
-            reach: if beyond_range {
-                max_range
-            } else {
-                interval.far + delta
-            },
-            near: interval.near,
             depth: interval.depth,
-            far: interval.far,
             height,
-            free: model.free(operator, interval.confidence),
+            free: if free_end > f32::NEG_INFINITY {
+                free
+            } else {
+                0.0
+            },
+            free_weight,
             confidence: interval.confidence,
         }
     }
 
     fn is_valid(&self) -> bool {
         self.reach > f32::NEG_INFINITY
+    }
+
+    /// The low end of the occupied kernel, `P- - δ` (the free evidence's full-strength end).
+    #[inline]
+    fn kernel_low(&self) -> f32 {
+        self.free_until
     }
 
     /// Evidence for a voxel whose centre lies at depth `z` on this pixel.
@@ -253,22 +311,34 @@ impl PixelEvidence {
                 free: self.free,
             });
         }
-        if z > self.reach || self.height <= 0.0 {
+        if z > self.reach {
             return None;
         }
-        let (low, high) = (self.near - delta, self.far + delta);
-        let shape = if (z - self.depth).abs() <= delta {
-            1.0
-        } else if z < self.depth {
-            (z - low) / (self.depth - delta - low)
+        let free = if z < self.free_end {
+            let psi = (self.free_end - z) / (self.free_end - self.free_until);
+            model.free(operator, self.free_weight * psi)
         } else {
-            (high - z) / (high - (self.depth + delta))
+            0.0
         };
-        let phi = (self.height * shape).clamp(0.0, 1.0);
-        (phi > 0.0).then(|| Evidence {
-            occupied: model.occupied(operator, self.confidence, phi),
-            free: 0.0,
-        })
+        let occupied = if self.height > 0.0 {
+            let (low, high) = (self.kernel_low(), self.reach);
+            let shape = if (z - self.depth).abs() <= delta {
+                1.0
+            } else if z < self.depth {
+                (z - low) / (self.depth - delta - low)
+            } else {
+                (high - z) / (high - (self.depth + delta))
+            };
+            let phi = (self.height * shape).clamp(0.0, 1.0);
+            if phi > 0.0 {
+                model.occupied(operator, self.confidence, phi)
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        (occupied > 0.0 || free > 0.0).then_some(Evidence { occupied, free })
     }
 }
 
@@ -665,9 +735,14 @@ mod tests {
             let frame = DepthFrame::new(k, pose, image).unwrap();
             let pixels: Vec<PixelEvidence> = (0..n)
                 .map(|i| {
-                    frame.image().pixel(i).map_or(PixelEvidence::NONE, |p| {
-                        PixelEvidence::new(p, &model, &operator, f32::INFINITY, half_diagonal)
-                    })
+                    PixelEvidence::of(
+                        frame.image(),
+                        i,
+                        &model,
+                        &operator,
+                        f32::INFINITY,
+                        half_diagonal,
+                    )
                 })
                 .collect();
             let tiles = TileReach::new(&pixels, k.width(), k.height());
@@ -736,9 +811,14 @@ mod tests {
         let half_diagonal = (0.5 * 3f64.sqrt() * resolution.size()) as f32;
         let pixels: Vec<PixelEvidence> = (0..n)
             .map(|i| {
-                frame.image().pixel(i).map_or(PixelEvidence::NONE, |p| {
-                    PixelEvidence::new(p, &model, &operator, f32::INFINITY, half_diagonal)
-                })
+                PixelEvidence::of(
+                    frame.image(),
+                    i,
+                    &model,
+                    &operator,
+                    f32::INFINITY,
+                    half_diagonal,
+                )
             })
             .collect();
         let mut fast = ScanEvidence::new();

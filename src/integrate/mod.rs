@@ -21,7 +21,9 @@ mod scan_sets;
 
 pub use cloud::PointCloud;
 pub use depth_image::{DepthFrame, IntervalDepthImage};
-pub use evidence::{Evidence, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence};
+pub use evidence::{
+    Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence,
+};
 pub use frustum::depth_evidence;
 pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;

@@ -72,8 +72,12 @@ pub fn cloud_evidence(
                     };
                     stats.integrated += 1;
                     stats.clipped += usize::from(ray.clipped);
-                    let c = cloud.confidence_of(chunk_index * CHUNK + offset);
-                    ray.deposit(&mut acc, resolution, origin_key, model, operator, c);
+                    let index = chunk_index * CHUNK + offset;
+                    let weight = PointWeight {
+                        confidence: cloud.confidence_of(index),
+                        reliability: cloud.reliability_of(index),
+                    };
+                    ray.deposit(&mut acc, resolution, origin_key, model, operator, weight);
                 }
                 (scan, stats)
             },
@@ -91,6 +95,14 @@ pub fn cloud_evidence(
             },
         );
     Ok((evidence, stats))
+}
+
+/// A point's confidence (its end point's occupied evidence) and reliability (its ray's free
+/// evidence in the dual model).
+#[derive(Clone, Copy)]
+struct PointWeight {
+    confidence: f32,
+    reliability: f32,
 }
 
 /// One measurement ray, already cut at `max_range`.
@@ -131,16 +143,18 @@ impl Ray {
         origin_key: VoxelKey,
         model: &EvidenceModel,
         operator: &TConorm,
-        confidence: f32,
+        weight: PointWeight,
     ) {
-        if confidence <= 0.0 {
+        let confidence = weight.confidence;
+        let free_weight = model.free_weight(confidence, weight.reliability);
+        if confidence <= 0.0 && free_weight <= 0.0 {
             return;
         }
         // Validated by the caller.
         let Some(end_key) = resolution.try_key_of(&self.end) else {
             return;
         };
-        let free = model.free(operator, confidence);
+        let free = model.free(operator, free_weight);
         let sigma = self.range * model.angular_resolution;
         let reach = 2.0 * sigma;
         let kernel = !self.clipped && reach > 0.5 * resolution.size();
@@ -157,22 +171,26 @@ impl Ray {
         let mut steps_to_end = (origin_key.x - end_key.x).abs()
             + (origin_key.y - end_key.y).abs()
             + (origin_key.z - end_key.z).abs();
-        walk_ray(
-            resolution,
-            &self.origin,
-            &self.end,
-            origin_key,
-            end_key,
-            |key| {
-                let close = steps_to_end <= near_end;
-                steps_to_end -= 1;
-                if close && (resolution.center(key) - self.end).norm() <= reach {
-                    return;
-                }
-                raise(acc, key, 0.0, free);
-            },
-        );
-        if self.clipped {
+        // A ray of no free weight (dual model, reliability 0) still marks its end point.
+        let kernel_only = free <= 0.0;
+        if !kernel_only {
+            walk_ray(
+                resolution,
+                &self.origin,
+                &self.end,
+                origin_key,
+                end_key,
+                |key| {
+                    let close = steps_to_end <= near_end;
+                    steps_to_end -= 1;
+                    if close && (resolution.center(key) - self.end).norm() <= reach {
+                        return;
+                    }
+                    raise(acc, key, 0.0, free);
+                },
+            );
+        }
+        if self.clipped || confidence <= 0.0 {
             return;
         }
         raise(acc, end_key, model.occupied(operator, confidence, 1.0), 0.0);

@@ -5,7 +5,7 @@
 //! | bytes | field |
 //! |---|---|
 //! | 0..8 | magic `FUZZYVOX` |
-//! | 8..10 | format version (1) |
+//! | 8..10 | format version (2; 1 is still read) |
 //! | 10 | map kind (1 fuzzy, 2 log-odds, 3 alpha-cut) |
 //! | 11 | operator family code (255: none) |
 //! | 12..20 | operator parameter (f64; 0 when the family has none) |
@@ -23,7 +23,11 @@ use crate::error::{Error, FormatError, Result};
 use crate::ops::Family;
 
 const MAGIC: &[u8; 8] = b"FUZZYVOX";
-const VERSION: u16 = 1;
+const VERSION: u16 = 2;
+/// The oldest version still read. Version 2 added the evidence model's kind and free reach to
+/// fuzzy maps' settings; a version 1 fuzzy map was built with the paper's model and loads as
+/// such. Log-odds and alpha-cut bodies are the same in both.
+const OLDEST_VERSION: u16 = 1;
 const HEADER_LEN: usize = 40;
 const NO_OPERATOR: u8 = 255;
 
@@ -130,7 +134,7 @@ pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
         });
     };
     let version = u16::from_le_bytes(field(header, 8));
-    if version != VERSION {
+    if !(OLDEST_VERSION..=VERSION).contains(&version) {
         return Err(FormatError::UnsupportedVersion(version));
     }
     let body_len = u64::from_le_bytes(field(header, 28));

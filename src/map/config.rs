@@ -45,6 +45,13 @@ impl FuzzyConfig {
         self
     }
 
+    /// The same configuration with another evidence model (for example
+    /// [`EvidenceModel::paper`] to compare with the paper's model).
+    pub fn with_evidence(mut self, evidence: EvidenceModel) -> Self {
+        self.evidence = evidence;
+        self
+    }
+
     /// Checks every part (useful after editing fields or decoding a file).
     pub fn validate(self) -> Result<Self> {
         Resolution::new(self.resolution.size())?;

@@ -1,0 +1,240 @@
+//! The dual evidence model, part by part: a pixel without a far bound still clears up to its
+//! near bound, free evidence is graded and falls monotonically through the interval, and free
+//! evidence does not depend on the interval's width or the confidence; point clouds the same.
+//! The paper's model, kept for comparison, is checked beside it.
+
+use fuzzyvox::integrate::depth_evidence;
+use fuzzyvox::storage::Resolution;
+use fuzzyvox::{
+    DepthFrame, Evidence, EvidenceKind, EvidenceModel, FuzzyConfig, FuzzyMap, IntegrationOptions,
+    IntervalDepthImage, Memberships, PinholeIntrinsics, PointCloud, TConorm, VoxelMap,
+};
+use nalgebra::{Isometry3, Point3};
+
+const RES: f64 = 0.1;
+/// Half a voxel diagonal at `RES`.
+const DELTA: f64 = 0.5 * 1.732_050_8 * RES;
+const SIDE: u32 = 64;
+
+fn map(model: EvidenceModel) -> FuzzyMap {
+    FuzzyMap::new(FuzzyConfig::new(RES).unwrap().with_evidence(model)).unwrap()
+}
+
+/// A camera at the origin looking along +z whose every pixel has the same interval.
+fn frame(near: f32, depth: f32, far: f32, confidence: f32, reliability: Option<f32>) -> DepthFrame {
+    let n = (SIDE * SIDE) as usize;
+    let mut image = IntervalDepthImage::new(
+        SIDE,
+        SIDE,
+        vec![near; n],
+        vec![depth; n],
+        vec![far; n],
+        vec![confidence; n],
+    )
+    .unwrap();
+    if let Some(r) = reliability {
+        image = image.with_reliability(vec![r; n]).unwrap();
+    }
+    let k = PinholeIntrinsics::new(SIDE, SIDE, 50.0, 50.0, 31.5, 31.5).unwrap();
+    DepthFrame::new(k, Isometry3::identity(), image).unwrap()
+}
+
+/// Memberships of the voxels just beside the optical axis, by the depth of their centres.
+fn along_axis(map: &FuzzyMap) -> Vec<(f64, Memberships)> {
+    (1..120)
+        .map(|k| {
+            let centre = Point3::new(-0.05, -0.05, (f64::from(k) + 0.5) * RES);
+            (centre.z, map.memberships_at_point(&centre).unwrap())
+        })
+        .collect()
+}
+
+fn integrate(model: EvidenceModel, frame: &DepthFrame) -> FuzzyMap {
+    let mut m = map(model);
+    m.integrate_depth(frame, &IntegrationOptions::default())
+        .unwrap();
+    m
+}
+
+#[test]
+fn a_pixel_without_a_far_bound_clears_up_to_its_near_bound() {
+    // P+ undefined (the disparity's far end at infinity) and no confidence, but a reliable match.
+    let without_far = frame(3.0, 5.0, f32::NAN, f32::NAN, Some(1.0));
+    let dual = along_axis(&integrate(EvidenceModel::dual(), &without_far));
+    for (z, m) in &dual {
+        assert_eq!(
+            m.occupied, 0.0,
+            "no occupied evidence without a confidence (z = {z})"
+        );
+        if *z < 3.0 - DELTA {
+            assert!(m.free >= 0.59, "z = {z}: free {} in front of P-", m.free);
+        }
+        if *z > 4.0 {
+            assert_eq!(m.free, 0.0, "z = {z}: cleared past the profile's end");
+        }
+    }
+    // The paper's model reads only pixels with all three depths and a confidence.
+    let paper = integrate(EvidenceModel::paper(), &without_far);
+    assert!(paper.cells().next().is_none());
+    // Without reliability, the same pixel gives nothing in the dual model either.
+    let unreliable = frame(3.0, 5.0, f32::NAN, f32::NAN, Some(0.0));
+    assert!(
+        integrate(EvidenceModel::dual(), &unreliable)
+            .cells()
+            .next()
+            .is_none()
+    );
+}
+
+#[test]
+fn free_membership_falls_monotonically_through_the_interval() {
+    let model = EvidenceModel::dual();
+    let cells = along_axis(&integrate(model, &frame(3.0, 5.0, 8.0, 0.8, Some(1.0))));
+    let profile_end = 3.0 + f64::from(model.free_reach) * 2.0 - DELTA;
+    let mut graded = 0;
+    for pair in cells.windows(2) {
+        let ((z0, a), (z1, b)) = (pair[0], pair[1]);
+        assert!(
+            b.free <= a.free,
+            "free rises from {} at z = {z0} to {} at z = {z1}",
+            a.free,
+            b.free
+        );
+        if z0 > 3.0 - DELTA && z0 < profile_end && a.free > 0.0 {
+            graded += 1;
+            assert!(
+                a.free < cells[0].1.free,
+                "z = {z0} inside the interval at full strength"
+            );
+        }
+    }
+    assert!(
+        graded >= 3,
+        "only {graded} voxels with graded free evidence"
+    );
+    for (z, m) in &cells {
+        if *z >= profile_end {
+            assert_eq!(m.free, 0.0, "z = {z} beyond the profile's end");
+        }
+    }
+    // The paper's model stops at P- - δ.
+    let paper = along_axis(&integrate(
+        EvidenceModel::paper(),
+        &frame(3.0, 5.0, 8.0, 0.8, None),
+    ));
+    assert!(paper.iter().all(|(z, m)| *z < 3.0 - DELTA || m.free == 0.0));
+}
+
+/// The evidence one frame gives the voxels beside the optical axis, before the map folds it in.
+fn evidence_along_axis(model: EvidenceModel, frame: &DepthFrame) -> Vec<(f64, Evidence)> {
+    let resolution = Resolution::new(RES).unwrap();
+    let (scan, _) = depth_evidence(
+        frame,
+        &resolution,
+        &model,
+        &TConorm::default(),
+        &IntegrationOptions::default(),
+    )
+    .unwrap();
+    (1..120)
+        .map(|k| {
+            let centre = Point3::new(-0.05, -0.05, (f64::from(k) + 0.5) * RES);
+            let key = resolution.key_of(&centre).unwrap();
+            (centre.z, scan.cell(key).copied().unwrap_or_default())
+        })
+        .collect()
+}
+
+#[test]
+fn free_evidence_does_not_depend_on_the_interval_width_or_the_confidence() {
+    let model = EvidenceModel::dual();
+    // Through the whole profile, the free evidence a frame gives is the same bit for bit.
+    let narrow = evidence_along_axis(model, &frame(3.0, 5.0, 6.0, 0.9, Some(0.7)));
+    let wide = evidence_along_axis(model, &frame(3.0, 5.0, 40.0, 0.05, Some(0.7)));
+    let mut occupied_differs = false;
+    for ((z, a), (_, b)) in narrow.iter().zip(&wide) {
+        assert_eq!(a.free.to_bits(), b.free.to_bits(), "z = {z}: {a:?} {b:?}");
+        occupied_differs |= a.occupied != b.occupied;
+    }
+    assert!(
+        occupied_differs,
+        "occupied evidence should follow the confidence"
+    );
+    assert!(narrow.iter().any(|(z, e)| *z > 3.0 && e.free > 0.0));
+    // In the map, a voxel that the same frame also claims occupied keeps "free and not
+    // occupied" (`FuzzyMap::apply_evidence`); in front of the interval the memberships are
+    // equal bit for bit.
+    let narrow = along_axis(&integrate(model, &frame(3.0, 5.0, 6.0, 0.9, Some(0.7))));
+    let wide = along_axis(&integrate(model, &frame(3.0, 5.0, 40.0, 0.05, Some(0.7))));
+    for ((z, a), (_, b)) in narrow.iter().zip(&wide) {
+        if *z < 3.0 - DELTA {
+            assert_eq!(a.free.to_bits(), b.free.to_bits(), "z = {z}");
+        }
+    }
+    // The reliability does change it: half as reliable, half an observation.
+    let half = along_axis(&integrate(model, &frame(3.0, 5.0, 6.0, 0.9, Some(0.35))));
+    let (full, halved) = (narrow[5].1.free, half[5].1.free);
+    assert!(
+        (1.0 - halved - (1.0 - full).sqrt()).abs() < 1e-6,
+        "{full} {halved}"
+    );
+    // In the paper's model the width does change free evidence, through the confidence.
+    let paper = EvidenceModel {
+        kind: EvidenceKind::Paper,
+        ..EvidenceModel::paper()
+    };
+    let a = along_axis(&integrate(paper, &frame(3.0, 5.0, 6.0, 0.9, None)));
+    let b = along_axis(&integrate(paper, &frame(3.0, 5.0, 40.0, 0.05, None)));
+    assert!(a[5].1.free > b[5].1.free);
+}
+
+#[test]
+fn point_clouds_weigh_free_space_by_reliability_in_the_dual_model() {
+    let points = vec![Point3::new(0.05, 0.05, 2.05)];
+    let cloud = |confidence: f32, reliability: Option<f32>| {
+        let c = PointCloud::new(Point3::new(0.05, 0.05, 0.05), points.clone())
+            .unwrap()
+            .with_confidence(vec![confidence])
+            .unwrap();
+        match reliability {
+            Some(r) => c.with_reliability(vec![r]).unwrap(),
+            None => c,
+        }
+    };
+    let free_at = |model: EvidenceModel, cloud: &PointCloud| {
+        let mut m = map(model);
+        m.integrate_cloud(cloud, &IntegrationOptions::default())
+            .unwrap();
+        m.memberships_at_point(&Point3::new(0.05, 0.05, 1.05))
+            .unwrap()
+    };
+    let dual = EvidenceModel::dual();
+    // A point without confidence still clears its ray when it is reliable.
+    let cleared = free_at(dual, &cloud(0.0, Some(1.0)));
+    assert!(cleared.free > 0.59 && cleared.occupied == 0.0);
+    assert_eq!(
+        free_at(EvidenceModel::paper(), &cloud(0.0, Some(1.0))).free,
+        0.0
+    );
+    // Free evidence follows the reliability, not the confidence.
+    assert_eq!(
+        free_at(dual, &cloud(0.2, None)).free.to_bits(),
+        free_at(dual, &cloud(1.0, None)).free.to_bits()
+    );
+    assert!(free_at(dual, &cloud(1.0, Some(0.25))).free < free_at(dual, &cloud(1.0, None)).free);
+    assert!(
+        free_at(EvidenceModel::paper(), &cloud(0.2, None)).free
+            < free_at(EvidenceModel::paper(), &cloud(1.0, None)).free
+    );
+}
+
+#[test]
+fn the_dual_model_is_the_default_and_both_models_validate() {
+    assert_eq!(EvidenceModel::default(), EvidenceModel::dual());
+    assert_eq!(EvidenceModel::default().kind, EvidenceKind::Dual);
+    let mut bad = EvidenceModel::dual();
+    bad.free_reach = 1.5;
+    assert!(FuzzyMap::new(FuzzyConfig::new(RES).unwrap().with_evidence(bad)).is_err());
+    bad.free_reach = f32::NAN;
+    assert!(FuzzyMap::new(FuzzyConfig::new(RES).unwrap().with_evidence(bad)).is_err());
+}
