@@ -38,6 +38,7 @@ fn parse_variant(spec: &str) -> Result<(String, EvidenceModel), String> {
             "falloff" => model.interval_falloff = value,
             "free_gain" => model.free_gain = value,
             "occupied_gain" => model.occupied_gain = value,
+            "fill" => model.fill_footprints = value != 0.0,
             _ => return Err(format!("variant {name}: unknown setting {key}")),
         }
     }

@@ -4,6 +4,8 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use nalgebra::Isometry3;
+
 use serde::Serialize;
 
 use super::flights::{
@@ -176,27 +178,54 @@ impl ExperimentReport {
     }
 }
 
-/// The true depth seen by a depth image's own camera (the rectified reference camera for a
-/// rectified pair): every pixel that sees a surface within the scenario's range, exact. A pixel
-/// that sees the sky, or a surface beyond the range the depth stage searches, gives no depth,
-/// as it gives none to any camera-built map. Inserted into a log-odds map, these frames are the
-/// planned flights' ground truth: the space the cameras saw free.
-fn seen_from(scenario: &Scenario, frame: &DepthFrame) -> Result<DepthFrame> {
-    let truth = render(
-        &scenario.scene,
-        frame.intrinsics(),
-        frame.world_from_camera(),
-        0,
-        scenario.max_range * 4.0,
-    );
+/// The true depth that a stereo pair could measure, in its depth image's own camera (the
+/// rectified reference camera of a rectified pair): every pixel that sees a surface within the
+/// scenario's range, at a point that the pair's other view sees too, inside the matching
+/// window's margin of its image. A pixel that sees the sky, a surface beyond the range the depth
+/// stage searches, or a point the other view does not see, has no stereo depth for any matcher.
+/// Inserted into a log-odds map, these frames are the planned flights' ground truth: the space
+/// the cameras saw free.
+fn seen_from(
+    scenario: &Scenario,
+    frame: &DepthFrame,
+    other: &Isometry3<f64>,
+    margin: f64,
+) -> Result<DepthFrame> {
+    let k = frame.intrinsics();
+    let pose = frame.world_from_camera();
+    let truth = render(&scenario.scene, k, pose, 0, scenario.max_range * 4.0);
     let range = scenario.max_range as f32;
+    let seen_by_other = |u: f64, v: f64, z: f64| {
+        let point = pose * k.back_project(u, v, z);
+        let in_other = other.inverse_transform_point(&point);
+        let o = &scenario.intrinsics;
+        in_other.z > 0.0 && {
+            let (x, y) = (
+                o.fx() * in_other.x / in_other.z + o.cx(),
+                o.fy() * in_other.y / in_other.z + o.cy(),
+            );
+            x >= margin
+                && y >= margin
+                && x <= f64::from(o.width()) - 1.0 - margin
+                && y <= f64::from(o.height()) - 1.0 - margin
+        }
+    };
+    let width = truth.width as usize;
     let depth: Vec<f32> = truth
         .depth
         .iter()
-        .map(|&z| if z <= range { z } else { f32::NAN })
+        .enumerate()
+        .map(|(i, &z)| {
+            let (u, v) = ((i % width) as f64, (i / width) as f64);
+            if z <= range && seen_by_other(u, v, f64::from(z)) {
+                z
+            } else {
+                f32::NAN
+            }
+        })
         .collect();
     let image = IntervalDepthImage::from_depth(truth.width, truth.height, &depth, |z| (z, z, 1.0))?;
-    DepthFrame::new(*frame.intrinsics(), *frame.world_from_camera(), image)
+    DepthFrame::new(*k, *pose, image)
 }
 
 /// Runs a scenario: renders every pair, runs the depth stage once per pair, feeds the same
@@ -328,7 +357,15 @@ pub fn run_experiment_with_progress(
                 }
             };
             if let Some(truth_map) = &mut camera_truth {
-                truth_map.integrate_depth(&seen_from(scenario, &depth_frame)?, &options)?;
+                let margin = f64::from(
+                    depth
+                        .matching
+                        .window_width
+                        .max(depth.matching.window_height)
+                        / 2,
+                );
+                let seen = seen_from(scenario, &depth_frame, other, margin)?;
+                truth_map.integrate_depth(&seen, &options)?;
             }
             let t = Instant::now();
             for (_, map) in maps.iter_mut() {

@@ -103,6 +103,11 @@ pub struct EvidenceModel {
     /// whose centre is cleared lies wholly in front of the bound). 0 stops at `P-`, as the
     /// paper's model does. In `[0, 1]`; ignored by the paper's model.
     pub free_reach: f32,
+    /// Dual model: a voxel whose centre falls on a depth-image pixel without a measurement
+    /// reads the measured pixels of its footprint instead (free in front of the nearest of
+    /// their near bounds, with the least of their free weights), as the rays of a point-cloud
+    /// integrator would clear it. Default on; ignored by the paper's model.
+    pub fill_footprints: bool,
 }
 
 impl EvidenceModel {
@@ -157,6 +162,7 @@ impl EvidenceModel {
             angular_resolution: 0.002,
             interval_falloff: 1.0,
             free_reach: 0.0,
+            fill_footprints: false,
         }
     }
 
@@ -165,6 +171,7 @@ impl EvidenceModel {
         Self {
             kind: EvidenceKind::Dual,
             free_reach: 0.5,
+            fill_footprints: true,
             ..Self::paper()
         }
     }

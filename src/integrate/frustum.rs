@@ -5,6 +5,7 @@ use super::depth_image::{DepthFrame, IntervalDepthImage, PixelInterval};
 use super::evidence::{
     Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence,
 };
+use super::footprint::FootprintFill;
 use crate::error::{Error, Result};
 use crate::ops::TConorm;
 use crate::storage::{
@@ -74,7 +75,28 @@ pub fn depth_evidence(
         return Ok((ScanEvidence::new(), stats));
     }
 
-    let tiles = TileReach::new(&pixels, width, height);
+    let fill = (model.kind == EvidenceKind::Dual && model.fill_footprints).then(|| {
+        let free_bound = |p: &PixelEvidence| {
+            if p.is_valid() && p.free > 0.0 {
+                p.free_until
+            } else {
+                f32::INFINITY
+            }
+        };
+        let bound: Vec<f32> = pixels.iter().map(free_bound).collect();
+        let weight: Vec<f32> = pixels
+            .iter()
+            .map(|p| {
+                if free_bound(p).is_finite() {
+                    p.free_weight
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        FootprintFill::new(&bound, &weight, width as usize, height as usize)
+    });
+    let tiles = TileReach::new(&pixels, fill.as_ref(), width, height);
     let camera = CameraView::new(frame, resolution);
     let frustum = frustum_box(frame, resolution, tiles.max_reach)?;
     if frustum.block_count() > MAX_FRUSTUM_BLOCKS {
@@ -90,7 +112,7 @@ pub fn depth_evidence(
         .par_iter()
         .filter_map(|&key| {
             camera
-                .block_evidence(key, &pixels, model, operator, half_diagonal)
+                .block_evidence(key, &pixels, fill.as_ref(), model, operator, half_diagonal)
                 .map(|b| (key, b))
         })
         .collect();
@@ -351,14 +373,24 @@ struct TileReach {
 }
 
 impl TileReach {
-    fn new(pixels: &[PixelEvidence], width: u32, height: u32) -> Self {
+    /// With `fill`, a pixel without evidence reaches as far as its footprint's fill can.
+    fn new(
+        pixels: &[PixelEvidence],
+        fill: Option<&FootprintFill>,
+        width: u32,
+        height: u32,
+    ) -> Self {
         let columns = width.div_ceil(TILE);
         let rows = height.div_ceil(TILE);
         let mut reach = vec![f32::NEG_INFINITY; (columns * rows) as usize];
         for (i, p) in pixels.iter().enumerate() {
             let (x, y) = (i as u32 % width, i as u32 / width);
             let t = ((y / TILE) * columns + x / TILE) as usize;
-            reach[t] = reach[t].max(p.reach);
+            let r = match fill {
+                Some(fill) if !p.is_valid() => fill.reach(i),
+                _ => p.reach,
+            };
+            reach[t] = reach[t].max(r);
         }
         let max_reach = reach.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         Self {
@@ -624,10 +656,13 @@ impl CameraView {
         &self,
         key: BlockKey,
         pixels: &[PixelEvidence],
+        fill: Option<&FootprintFill>,
         model: &EvidenceModel,
         operator: &TConorm,
         delta: f32,
     ) -> Option<Box<Block<Evidence>>> {
+        // A voxel's footprint radius in pixels is `fx δ / z`.
+        let footprint = (self.fx.max(self.fy) as f32) * delta;
         let size = self.resolution.size();
         let first = self.to_camera(&self.resolution.center(key.origin()));
         let step_x = self.camera_from_world.column(0) * size;
@@ -646,7 +681,19 @@ impl CameraView {
                 continue;
             }
             let index = v as usize * self.width as usize + u as usize;
-            if let Some(e) = pixels[index].at(p.z as f32, model, operator, delta) {
+            let z = p.z as f32;
+            let pixel = &pixels[index];
+            let evidence = match fill {
+                Some(fill) if !pixel.is_valid() => fill
+                    .lookup(index, footprint / z)
+                    .filter(|&(bound, _)| z < bound)
+                    .map(|(_, weight)| Evidence {
+                        occupied: 0.0,
+                        free: model.free(operator, weight),
+                    }),
+                _ => pixel.at(z, model, operator, delta),
+            };
+            if let Some(e) = evidence {
                 block.get_or_insert_with(Box::default).cells[cell] = e;
             }
         }
@@ -745,7 +792,7 @@ mod tests {
                     )
                 })
                 .collect();
-            let tiles = TileReach::new(&pixels, k.width(), k.height());
+            let tiles = TileReach::new(&pixels, None, k.width(), k.height());
             let camera = CameraView::new(&frame, &resolution);
             let frustum = frustum_box(&frame, &resolution, tiles.max_reach).unwrap();
             let kept = camera.observed_blocks(&frustum, &tiles);
@@ -754,7 +801,7 @@ mod tests {
             let mut with_evidence = 0;
             for &key in &all {
                 let evidence =
-                    camera.block_evidence(key, &pixels, &model, &operator, half_diagonal);
+                    camera.block_evidence(key, &pixels, None, &model, &operator, half_diagonal);
                 if evidence.is_some() {
                     with_evidence += 1;
                     assert!(

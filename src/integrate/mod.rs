@@ -13,6 +13,7 @@
 mod cloud;
 mod depth_image;
 mod evidence;
+mod footprint;
 mod frustum;
 mod octomap_walk;
 mod points;
