@@ -47,15 +47,21 @@ fn parse_variant(spec: &str) -> Result<(String, EvidenceModel), String> {
 
 fn default_variants() -> Vec<(String, EvidenceModel)> {
     let dual = EvidenceModel::dual();
-    let paper = EvidenceModel::paper();
+    // Each step adds one part of the dual model to the one before.
+    let reliability = EvidenceModel {
+        kind: EvidenceKind::Dual,
+        free_reach: 0.0,
+        fill_footprints: false,
+        ..dual
+    };
     vec![
-        ("paper".into(), paper),
+        ("paper".into(), EvidenceModel::paper()),
+        ("+reliability".into(), reliability),
         (
-            "+reliability".into(),
+            "+footprints".into(),
             EvidenceModel {
-                kind: EvidenceKind::Dual,
-                free_reach: 0.0,
-                ..dual
+                fill_footprints: true,
+                ..reliability
             },
         ),
         ("+profile (dual)".into(), dual),

@@ -238,3 +238,48 @@ fn the_dual_model_is_the_default_and_both_models_validate() {
     bad.free_reach = f32::NAN;
     assert!(FuzzyMap::new(FuzzyConfig::new(RES).unwrap().with_evidence(bad)).is_err());
 }
+
+#[test]
+fn voxels_over_unmeasured_pixels_read_their_footprint() {
+    // Every other pixel has no measurement (a sparse stereo depth image); near the camera each
+    // voxel spans several pixels, so it clears from its measured neighbours.
+    let n = (SIDE * SIDE) as usize;
+    let holes = |plane: f32| -> Vec<f32> {
+        (0..n)
+            .map(|i| {
+                if (i + i / SIDE as usize) % 2 == 0 {
+                    plane
+                } else {
+                    f32::NAN
+                }
+            })
+            .collect()
+    };
+    let image = IntervalDepthImage::new(SIDE, SIDE, holes(3.0), holes(5.0), holes(8.0), holes(0.8))
+        .unwrap()
+        .with_reliability(holes(1.0))
+        .unwrap();
+    let k = PinholeIntrinsics::new(SIDE, SIDE, 50.0, 50.0, 31.5, 31.5).unwrap();
+    let sparse = DepthFrame::new(k, Isometry3::identity(), image).unwrap();
+    let count_free = |model: EvidenceModel| {
+        let map = integrate(model, &sparse);
+        map.cells()
+            .filter(|(_, m)| m.free > 0.0 && m.occupied == 0.0)
+            .count()
+    };
+    let without = EvidenceModel {
+        fill_footprints: false,
+        ..EvidenceModel::dual()
+    };
+    let (filled, sampled) = (count_free(EvidenceModel::dual()), count_free(without));
+    assert!(
+        filled as f64 > 1.2 * sampled as f64,
+        "{filled} free voxels with footprints, {sampled} without"
+    );
+    // Nothing is cleared past the nearest near bound.
+    for (z, m) in along_axis(&integrate(EvidenceModel::dual(), &sparse)) {
+        if z > 3.0 - DELTA + 0.5 * 2.0 {
+            assert_eq!(m.free, 0.0, "z = {z}");
+        }
+    }
+}
