@@ -247,7 +247,7 @@ fn voxels_over_unmeasured_pixels_read_their_footprint() {
     let holes = |plane: f32| -> Vec<f32> {
         (0..n)
             .map(|i| {
-                if (i + i / SIDE as usize) % 2 == 0 {
+                if (i + i / SIDE as usize).is_multiple_of(2) {
                     plane
                 } else {
                     f32::NAN
