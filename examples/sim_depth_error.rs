@@ -59,6 +59,35 @@ impl Soundness {
     }
 }
 
+/// Prints one soundness table: the first half of `groups` holds rectified pixels, the second
+/// half plane-swept ones, each half by the bins `bins` (low, high).
+fn soundness_table(by: &str, groups: &[Soundness], bins: &[(f64, f64)], digits: usize) {
+    println!(
+        "\n| matching, {by} | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for (group, s) in groups.iter().enumerate() {
+        let (low, high) = bins[group % bins.len()];
+        let method = if group < bins.len() {
+            "rectified"
+        } else {
+            "plane sweep"
+        };
+        s.row(&format!(
+            "{method}, {low:.digits$}–{:.digits$}",
+            high.min(1.0)
+        ));
+    }
+}
+
+/// Bins `[0, e0), [e0, e1), …` from their upper ends.
+fn from_ends(ends: &[f64]) -> Vec<(f64, f64)> {
+    ends.iter()
+        .enumerate()
+        .map(|(i, &high)| (if i == 0 { 0.0 } else { ends[i - 1] }, high))
+        .collect()
+}
+
 fn median(values: &mut [f32]) -> f32 {
     values.sort_by(f32::total_cmp);
     values.get(values.len() / 2).copied().unwrap_or(f32::NAN)
@@ -251,55 +280,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
-    println!(
-        "\n| matching, pair Q_ABD | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
-    );
-    println!("|---|---|---|---|---|---|");
-    for (group, s) in soundness.iter().enumerate() {
-        let (low, high) = QUALITY_BINS[group % 4];
-        let method = if group < 4 {
-            "rectified"
-        } else {
-            "plane sweep"
-        };
-        s.row(&format!("{method}, {low:.1}–{:.1}", high.min(1.0)));
-    }
-    println!(
-        "\n| matching, pixel parallax sine | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
-    );
-    println!("|---|---|---|---|---|---|");
-    for (group, s) in by_sine.iter().enumerate() {
-        let high = SINE_BINS[group % 6];
-        let low = if group % 6 == 0 {
-            0.0
-        } else {
-            SINE_BINS[group % 6 - 1]
-        };
-        let method = if group < 6 {
-            "rectified"
-        } else {
-            "plane sweep"
-        };
-        s.row(&format!("{method}, {low:.2}–{:.2}", high.min(1.0)));
-    }
-    println!(
-        "\n| matching, best window cost | pixels with P- and P0 | without P+ | truth before P- - δ | before the half-way profile end | before P0 - δ |"
-    );
-    println!("|---|---|---|---|---|---|");
-    for (group, s) in by_cost.iter().enumerate() {
-        let high = COST_BINS[group % 6];
-        let low = if group % 6 == 0 {
-            0.0
-        } else {
-            COST_BINS[group % 6 - 1]
-        };
-        let method = if group < 6 {
-            "rectified"
-        } else {
-            "plane sweep"
-        };
-        s.row(&format!("{method}, {low:.2}–{:.2}", high.min(1.0)));
-    }
+    soundness_table("pair Q_ABD", &soundness, &QUALITY_BINS, 1);
+    soundness_table("pixel parallax sine", &by_sine, &from_ends(&SINE_BINS), 2);
+    let cost_ends: Vec<f64> = COST_BINS.iter().map(|&e| f64::from(e)).collect();
+    soundness_table("best window cost", &by_cost, &from_ends(&cost_ends), 2);
     println!("\n| pair Q_ABD | rectified pairs | median of their median |disparity error| |");
     println!("|---|---|---|");
     for (low, high) in [(0.0, 0.6), (0.6, 0.8), (0.8, 0.95), (0.95, 1.01)] {

@@ -34,20 +34,12 @@ impl PointCloud {
 
     /// Attaches one confidence in `[0, 1]` per point.
     pub fn with_confidence(mut self, confidence: Vec<f32>) -> Result<Self> {
-        if confidence.len() != self.points.len() {
-            return Err(Error::SizeMismatch {
-                what: "confidence per point",
-                expected: self.points.len(),
-                found: confidence.len(),
-            });
-        }
-        if let Some((index, &value)) = confidence
-            .iter()
-            .enumerate()
-            .find(|(_, c)| !(0.0..=1.0).contains(*c))
-        {
-            return Err(Error::InvalidConfidence { index, value });
-        }
+        check_unit_plane(
+            "confidence per point",
+            &confidence,
+            self.points.len(),
+            false,
+        )?;
         self.confidence = Some(confidence);
         Ok(self)
     }
@@ -62,20 +54,12 @@ impl PointCloud {
     /// [`Error::SizeMismatch`] for a length other than the number of points,
     /// [`Error::InvalidConfidence`] for a value outside `[0, 1]` (NaN included).
     pub fn with_reliability(mut self, reliability: Vec<f32>) -> Result<Self> {
-        if reliability.len() != self.points.len() {
-            return Err(Error::SizeMismatch {
-                what: "reliability per point",
-                expected: self.points.len(),
-                found: reliability.len(),
-            });
-        }
-        if let Some((index, &value)) = reliability
-            .iter()
-            .enumerate()
-            .find(|(_, r)| !(0.0..=1.0).contains(*r))
-        {
-            return Err(Error::InvalidConfidence { index, value });
-        }
+        check_unit_plane(
+            "reliability per point",
+            &reliability,
+            self.points.len(),
+            false,
+        )?;
         self.reliability = Some(reliability);
         Ok(self)
     }
@@ -120,6 +104,28 @@ impl PointCloud {
     /// Whether the cloud has no points.
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
+    }
+}
+
+/// Checks that `values` holds `expected` values in `[0, 1]` (NaN too when `nan_allowed`):
+/// [`Error::SizeMismatch`] naming `what`, or [`Error::InvalidConfidence`] at the first bad value.
+pub(super) fn check_unit_plane(
+    what: &'static str,
+    values: &[f32],
+    expected: usize,
+    nan_allowed: bool,
+) -> Result<()> {
+    if values.len() != expected {
+        return Err(Error::SizeMismatch {
+            what,
+            expected,
+            found: values.len(),
+        });
+    }
+    let good = |v: f32| (0.0..=1.0).contains(&v) || (nan_allowed && v.is_nan());
+    match values.iter().enumerate().find(|(_, v)| !good(**v)) {
+        Some((index, &value)) => Err(Error::InvalidConfidence { index, value }),
+        None => Ok(()),
     }
 }
 

@@ -1,6 +1,6 @@
 use nalgebra::Isometry3;
 
-use super::cloud::PointCloud;
+use super::cloud::{PointCloud, check_unit_plane};
 use crate::error::{Error, Result};
 use crate::geometry::{PinholeIntrinsics, validate_pose};
 
@@ -142,20 +142,7 @@ impl IntervalDepthImage {
     /// [`Error::SizeMismatch`] for a plane of the wrong size, [`Error::InvalidConfidence`] for
     /// a value outside `[0, 1]`.
     pub fn with_reliability(mut self, reliability: Vec<f32>) -> Result<Self> {
-        if reliability.len() != self.depth.len() {
-            return Err(Error::SizeMismatch {
-                what: "reliability plane",
-                expected: self.depth.len(),
-                found: reliability.len(),
-            });
-        }
-        if let Some((index, &value)) = reliability
-            .iter()
-            .enumerate()
-            .find(|(_, r)| !r.is_nan() && !(0.0..=1.0).contains(*r))
-        {
-            return Err(Error::InvalidConfidence { index, value });
-        }
+        check_unit_plane("reliability plane", &reliability, self.depth.len(), true)?;
         self.reliability = Some(reliability);
         Ok(self)
     }
