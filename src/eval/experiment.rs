@@ -299,6 +299,14 @@ pub fn run_experiment_with_progress(
     let options = IntegrationOptions {
         max_range: Some(scenario.max_range),
     };
+    // Pixels this close to an image's border have no full matching window.
+    let match_margin = f64::from(
+        depth
+            .matching
+            .window_width
+            .max(depth.matching.window_height)
+            / 2,
+    );
     let mut phase_metrics: BTreeMap<String, BTreeMap<String, MapMetrics>> = BTreeMap::new();
     let (mut render_s, mut depth_s, mut integrate_s) = (0.0, 0.0, 0.0);
     let (mut rejected, mut swept) = (0, 0);
@@ -357,14 +365,7 @@ pub fn run_experiment_with_progress(
                 }
             };
             if let Some(truth_map) = &mut camera_truth {
-                let margin = f64::from(
-                    depth
-                        .matching
-                        .window_width
-                        .max(depth.matching.window_height)
-                        / 2,
-                );
-                let seen = seen_from(scenario, &depth_frame, other, margin)?;
+                let seen = seen_from(scenario, &depth_frame, other, match_margin)?;
                 truth_map.integrate_depth(&seen, &options)?;
             }
             let t = Instant::now();

@@ -57,10 +57,7 @@ pub fn depth_evidence(
     let half_diagonal = (0.5 * 3f64.sqrt() * resolution.size()) as f32;
 
     // Per pixel: its interval and the evidence that does not depend on the voxel.
-    let pixels: Vec<PixelEvidence> = (0..image.depth().len())
-        .into_par_iter()
-        .map(|i| PixelEvidence::of(image, i, model, operator, max_range, half_diagonal))
-        .collect();
+    let pixels = pixel_evidence(image, model, operator, max_range, half_diagonal);
     let integrated = pixels.iter().filter(|p| p.is_valid()).count();
     let stats = IntegrationStats {
         integrated,
@@ -182,6 +179,20 @@ fn mark_end_points(
     }
 }
 
+/// Every pixel's evidence that does not depend on the voxel, in parallel.
+fn pixel_evidence(
+    image: &IntervalDepthImage,
+    model: &EvidenceModel,
+    operator: &TConorm,
+    max_range: f32,
+    delta: f32,
+) -> Vec<PixelEvidence> {
+    (0..image.depth().len())
+        .into_par_iter()
+        .map(|i| PixelEvidence::of(image, i, model, operator, max_range, delta))
+        .collect()
+}
+
 /// What one pixel contributes, packed into 32 aligned bytes: voxels look their pixel up at
 /// random, and one record per half cache line keeps those reads to one line each. An invalid
 /// pixel is [`PixelEvidence::NONE`], whose reach is below every depth.
@@ -298,11 +309,7 @@ impl PixelEvidence {
             },
             depth: interval.depth,
             height,
-            free: if free_end > f32::NEG_INFINITY {
-                free
-            } else {
-                0.0
-            },
+            free,
             free_weight,
             confidence: interval.confidence,
         }
@@ -310,12 +317,6 @@ impl PixelEvidence {
 
     fn is_valid(&self) -> bool {
         self.reach > f32::NEG_INFINITY
-    }
-
-    /// The low end of the occupied kernel, `P- - δ` (the free evidence's full-strength end).
-    #[inline]
-    fn kernel_low(&self) -> f32 {
-        self.free_until
     }
 
     /// Evidence for a voxel whose centre lies at depth `z` on this pixel.
@@ -343,7 +344,8 @@ impl PixelEvidence {
             0.0
         };
         let occupied = if self.height > 0.0 {
-            let (low, high) = (self.kernel_low(), self.reach);
+            // The kernel spans `P- - δ` (where full free evidence ends) to the reach.
+            let (low, high) = (self.free_until, self.reach);
             let shape = if (z - self.depth).abs() <= delta {
                 1.0
             } else if z < self.depth {
@@ -780,18 +782,13 @@ mod tests {
             })
             .unwrap();
             let frame = DepthFrame::new(k, pose, image).unwrap();
-            let pixels: Vec<PixelEvidence> = (0..n)
-                .map(|i| {
-                    PixelEvidence::of(
-                        frame.image(),
-                        i,
-                        &model,
-                        &operator,
-                        f32::INFINITY,
-                        half_diagonal,
-                    )
-                })
-                .collect();
+            let pixels = pixel_evidence(
+                frame.image(),
+                &model,
+                &operator,
+                f32::INFINITY,
+                half_diagonal,
+            );
             let tiles = TileReach::new(&pixels, None, k.width(), k.height());
             let camera = CameraView::new(&frame, &resolution);
             let frustum = frustum_box(&frame, &resolution, tiles.max_reach).unwrap();
@@ -856,18 +853,13 @@ mod tests {
         let operator = TConorm::default();
         let model = EvidenceModel::default();
         let half_diagonal = (0.5 * 3f64.sqrt() * resolution.size()) as f32;
-        let pixels: Vec<PixelEvidence> = (0..n)
-            .map(|i| {
-                PixelEvidence::of(
-                    frame.image(),
-                    i,
-                    &model,
-                    &operator,
-                    f32::INFINITY,
-                    half_diagonal,
-                )
-            })
-            .collect();
+        let pixels = pixel_evidence(
+            frame.image(),
+            &model,
+            &operator,
+            f32::INFINITY,
+            half_diagonal,
+        );
         let mut fast = ScanEvidence::new();
         mark_end_points(&mut fast, &frame, &pixels, &resolution, &model, &operator);
         let mut reference = ScanEvidence::new();
