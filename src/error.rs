@@ -159,6 +159,13 @@ pub enum FormatError {
         /// CRC of the bytes read.
         computed: u32,
     },
+    /// The file is none of the map formats fuzzyvox reads.
+    #[error(
+        "not a map file fuzzyvox reads: expected a fuzzyvox map (.fvx, starting with \
+         `FUZZYVOX`), an OctoMap binary tree (.bt, starting with `# Octomap OcTree binary file`) \
+         or an OctoMap tree (.ot, starting with `# Octomap OcTree file`)"
+    )]
+    UnknownMapFormat,
     /// The body could not be decoded or holds invalid values.
     #[error("invalid contents: {0}")]
     Invalid(String),

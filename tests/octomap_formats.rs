@@ -7,16 +7,16 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use common::octomap::{octomap_info, octomap_tool};
 use common::{Rng, data_dir};
 use fuzzyvox::io::octomap::{
     BtMap, decode_bt, encode_bt, read_bt, read_scan_graph, read_scan_log, write_bt,
 };
 use fuzzyvox::{Error, FormatError, VoxelKey, validate_pose};
 
-/// What OctoMap 1.9.7 reports for `geb079.bt`, obtained with
-/// `g++ -O2 scripts/octomap_tree_info.cpp -o target/octomap_tree_info -loctomap -loctomath`
-/// and `target/octomap_tree_info geb079.bt`, which printed
-/// `{"resolution":0.080000000000000002,"nodes":532566,"leaves":428144,"occupied":185673,"free":950759}`.
+/// What OctoMap 1.9.7 reports for `geb079.bt`: `scripts/octomap_check count geb079.bt` (built as
+/// its header says) prints `"leaves":428144, "occupied_voxels":185673, "free_voxels":950759,
+/// "nodes":532566`.
 const GEB079_NODES: usize = 532_566;
 const GEB079_LEAVES: usize = 428_144;
 const GEB079_OCCUPIED: u64 = 185_673;
@@ -170,70 +170,6 @@ fn synthetic_voxels_round_trip_and_prune() {
     let path = scratch("synthetic.bt");
     write_bt(&path, 0.05, map.voxels()).unwrap();
     assert_eq!(read_bt(&path).unwrap(), map);
-}
-
-/// Compiles `scripts/octomap_tree_info.cpp` into the target directory, or returns `None` after
-/// printing why when OctoMap is not installed (a failure with `FUZZYVOX_REQUIRE_OCTOMAP=1`).
-fn octomap_tool(test: &str) -> Option<PathBuf> {
-    let header = Path::new("/usr/include/octomap/octomap.h");
-    let compiler = Command::new("g++")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !(compiler && header.exists()) {
-        let why = format!(
-            "{test}: OctoMap is not installed (g++ found: {compiler}, {} found: {}) \
-             (apt-get install liboctomap-dev)",
-            header.display(),
-            header.exists()
-        );
-        assert!(
-            std::env::var("FUZZYVOX_REQUIRE_OCTOMAP").as_deref() != Ok("1"),
-            "FUZZYVOX_REQUIRE_OCTOMAP=1 but {why}"
-        );
-        eprintln!("SKIPPED {why}");
-        return None;
-    }
-    // One binary per test: tests run in parallel, and running a binary while another test
-    // rewrites it fails with "text file busy".
-    let tool = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("octomap_tree_info-{test}"));
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/octomap_tree_info.cpp");
-    let output = Command::new("g++")
-        .arg("-O2")
-        .arg(&source)
-        .arg("-o")
-        .arg(&tool)
-        .args(["-loctomap", "-loctomath"])
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "compiling {} failed:\n{}",
-        source.display(),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    Some(tool)
-}
-
-/// OctoMap's view of a `.bt` file: (nodes, leaves, occupied voxels, free voxels, resolution).
-fn octomap_info(tool: &Path, file: &Path) -> (usize, usize, u64, u64, f64) {
-    let output = Command::new(tool).arg(file).output().unwrap();
-    assert!(
-        output.status.success(),
-        "OctoMap could not read {}: {}",
-        file.display(),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let line = String::from_utf8(output.stdout).unwrap();
-    let json: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
-    let number = |key: &str| json[key].as_u64().unwrap();
-    (
-        number("nodes") as usize,
-        number("leaves") as usize,
-        number("occupied"),
-        number("free"),
-        json["resolution"].as_f64().unwrap(),
-    )
 }
 
 #[test]
@@ -484,7 +420,7 @@ fn bt_reader_accepts_what_octomap_accepts() {
     let voxels = synthetic();
     let good = encode_bt(0.05, voxels.iter().map(|(k, s)| (*k, *s))).unwrap();
     let map = decode_bt(&good).unwrap();
-    // OctoMap ignores bytes after the tree (checked with octomap_tree_info), and so do we.
+    // OctoMap ignores bytes after the tree (checked with scripts/octomap_check.cpp), and so do we.
     let mut trailing = good.clone();
     trailing.extend_from_slice(b"garbage\n");
     assert_eq!(decode_bt(&trailing).unwrap(), map);

@@ -2,10 +2,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
+use fuzzyvox::VoxelClass;
+use fuzzyvox::io::load_map;
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::io::ply::{PlyEncoding, write_ply};
 use fuzzyvox::io::views::{View, ViewColor, write_view_png};
-use fuzzyvox::{AnyMap, VoxelClass};
 use serde_json::{Value, json};
 use tracing::info;
 
@@ -38,7 +39,7 @@ use super::progress;
     fuzzyvox export scan.fvx --png slice.png --view slice --height 1.2 --color safety")]
 #[command(group(clap::ArgGroup::new("output").required(true).multiple(true).args(["bt", "ply", "png"])))]
 pub struct ExportArgs {
-    /// A map file written by `fuzzyvox insert --out` (or `rgbd --save`).
+    /// A map file: a fuzzyvox map (`insert --out`, `rgbd --save`), an OctoMap `.bt` or `.ot`.
     map: PathBuf,
     /// Write an OctoMap `.bt` file here.
     #[arg(long)]
@@ -105,9 +106,9 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
         (ViewArg::Side, None) => View::Side,
     };
     let spinner = progress::spinner("loading the map", args.json);
-    let map = AnyMap::load(&args.map)
-        .with_context(|| format!("loading the map {}", args.map.display()))?;
-    let mut report = json!({ "map": args.map, "model": map.kind().name() });
+    let map =
+        load_map(&args.map).with_context(|| format!("loading the map {}", args.map.display()))?;
+    let mut report = json!({ "map": args.map, "model": map.model_name() });
     let mut lines = Vec::new();
 
     if let Some(bt) = &args.bt {

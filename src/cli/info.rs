@@ -1,16 +1,21 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use fuzzyvox::AnyMap;
-use fuzzyvox::io::read_header;
+use fuzzyvox::io::{LoadedMap, load_map};
 use fuzzyvox::plan::ObservedExtent;
 use serde_json::json;
 
 /// Describe a saved map: kind, resolution, operator, voxel counts per class, extent and memory.
+///
+/// Reads fuzzyvox maps and OctoMap's `.bt` and `.ot` trees, told apart by content. An OctoMap
+/// tree's counts are its finest-level voxels (a pruned leaf counts every voxel it covers).
 #[derive(Args)]
-#[command(after_help = "Examples:\n  fuzzyvox info scan.fvx\n  fuzzyvox info scan.fvx --json")]
+#[command(after_help = "Examples:\n  \
+    fuzzyvox info scan.fvx\n  \
+    fuzzyvox info scan.fvx --json\n  \
+    fuzzyvox info geb079.bt --json")]
 pub struct InfoArgs {
-    /// A map file written by `fuzzyvox insert --out`.
+    /// A map file: a fuzzyvox map (`insert --out`), an OctoMap `.bt` or an OctoMap `.ot`.
     map: PathBuf,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -19,8 +24,7 @@ pub struct InfoArgs {
 
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     let loading = super::progress::spinner("loading the map", args.json);
-    let header = read_header(&args.map)?;
-    let map = AnyMap::load(&args.map)?;
+    let map = load_map(&args.map)?;
     loading.finish_and_clear();
     let view = map.as_map();
     let counts = view.counts();
@@ -30,12 +34,24 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
         let (lo, hi) = (e.min, e.max);
         ([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z])
     });
-    let operator = header.operator.map(|f| f.to_string());
+    let (version, operator) = match &map {
+        LoadedMap::Native { header, .. } => {
+            (Some(header.version), header.operator.map(|f| f.to_string()))
+        }
+        LoadedMap::OctoMap(_) => (None, None),
+    };
+    let tree = match &map {
+        LoadedMap::OctoMap(tree) => Some(json!({
+            "nodes": tree.node_count(),
+            "leaves": tree.leaf_count(),
+        })),
+        LoadedMap::Native { .. } => None,
+    };
     if args.json {
         return super::print_json(&json!({
             "path": args.map,
-            "format_version": header.version,
-            "model": header.kind.name(),
+            "format_version": version,
+            "model": map.model_name(),
             "resolution": resolution.size(),
             "operator": operator,
             "occupied": counts.occupied,
@@ -45,14 +61,24 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
             "memory_bytes": view.memory_bytes(),
             "bounds_min": corners.map(|c| c.0),
             "bounds_max": corners.map(|c| c.1),
+            "octree": tree,
         }));
     }
-    println!(
-        "{}: {} map, format version {}",
-        args.map.display(),
-        header.kind.name(),
-        header.version
-    );
+    match (&map, version) {
+        (LoadedMap::OctoMap(tree), _) => println!(
+            "{}: OctoMap tree ({}), {} nodes, {} leaves",
+            args.map.display(),
+            map.model_name(),
+            tree.node_count(),
+            tree.leaf_count()
+        ),
+        (_, version) => println!(
+            "{}: {} map, format version {}",
+            args.map.display(),
+            map.model_name(),
+            version.unwrap_or_default()
+        ),
+    }
     match operator {
         Some(op) => println!("resolution {} m, operator {op}", resolution.size()),
         None => println!("resolution {} m", resolution.size()),

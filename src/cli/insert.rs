@@ -5,7 +5,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use fuzzyvox::{Family, IntegrationOptions, IntegrationStats};
 
-use super::maps::{Evidence, Model, new_map};
+use super::maps::{Evidence, Model, PriorArgs, new_map};
 use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
@@ -18,7 +18,8 @@ use serde_json::json;
     fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
     fuzzyvox insert --cloud scan.dat --res 0.05 --model logodds --json\n  \
     fuzzyvox insert --cloud cloud.xyz --res 0.05 --origin 0,0,1.2 --max-range 20 --op dombi:2 --json\n  \
-    fuzzyvox insert --cloud confident.xyz --res 0.1 --model alpha --cuts 10 --out alpha.fvx")]
+    fuzzyvox insert --cloud confident.xyz --res 0.1 --model alpha --cuts 10 --out alpha.fvx\n  \
+    fuzzyvox insert --cloud new.xyz --res 0.08 --prior geb079.bt --prior-confidence 0.6 --out updated.fvx")]
 pub struct InsertArgs {
     /// Input scans: a text cloud, an OctoMap `.graph` or an OctoMap `.log`.
     #[arg(long)]
@@ -46,6 +47,8 @@ pub struct InsertArgs {
     /// Number of confidence cuts of the alpha model.
     #[arg(long, default_value_t = 10)]
     cuts: u32,
+    #[command(flatten)]
+    prior: PriorArgs,
     /// Write the map here (native format).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -62,7 +65,9 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     if args.model != Model::Fuzzy && args.evidence != Evidence::Dual {
         bail!("--evidence applies to the fuzzy model only");
     }
+    args.prior.check_models(&[args.model])?;
     let mut map = new_map(args.model, args.res, family, args.evidence, args.cuts)?;
+    let prior_voxels = args.prior.apply(&mut map)?;
     let reading = super::progress::spinner("reading the scans", args.json);
     let scans = super::input::read_scans(&args.cloud, args.origin)?;
     reading.finish_and_clear();
@@ -124,10 +129,19 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
             "unknown": counts.unknown,
             "insert_seconds": seconds,
             "memory_bytes": view.memory_bytes(),
+            "prior": args.prior.prior,
+            "prior_voxels": prior_voxels,
             "out": args.out,
         }));
     }
     let with = operator.map(|o| format!(" with {o}")).unwrap_or_default();
+    if let Some(prior) = &args.prior.prior {
+        println!(
+            "prior {}: {prior_voxels} voxels at confidence {}",
+            prior.display(),
+            args.prior.prior_confidence
+        );
+    }
     println!(
         "integrated {} of {points} points from {} scan(s) ({} skipped) into a {model} map at {} m{with} in {seconds:.3} s",
         total.integrated,

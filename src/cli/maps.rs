@@ -70,3 +70,58 @@ pub fn new_map(
         }
     })
 }
+
+/// The prior map options of the commands that build maps (`--prior`, `--prior-confidence`).
+#[derive(clap::Args, Clone, Debug)]
+pub struct PriorArgs {
+    /// Start the fuzzy map from this map: a fuzzyvox map, an OctoMap `.bt` or an OctoMap `.ot`
+    /// (told apart by content) of the same resolution. Its occupied and free voxels become
+    /// evidence of confidence `--prior-confidence`.
+    #[arg(long, value_name = "MAP")]
+    pub prior: Option<std::path::PathBuf>,
+    /// How much the prior map is trusted, in (0, 1].
+    #[arg(
+        long,
+        value_name = "C",
+        default_value_t = 0.5,
+        requires = "prior",
+        allow_negative_numbers = true
+    )]
+    pub prior_confidence: f32,
+}
+
+impl PriorArgs {
+    /// Refuses a prior for commands building other models than the fuzzy one.
+    pub fn check_models(&self, models: &[Model]) -> anyhow::Result<()> {
+        if self.prior.is_some() && models.iter().any(|m| *m != Model::Fuzzy) {
+            anyhow::bail!(
+                "--prior applies to the fuzzy model only (a log-odds or alpha-cut map has no \
+                 confidence to give a prior): add --model fuzzy"
+            );
+        }
+        Ok(())
+    }
+
+    /// Adds the prior, when one is given, to a fuzzy map; returns the number of voxels it
+    /// reached (0 without a prior).
+    pub fn apply(&self, map: &mut AnyMap) -> anyhow::Result<usize> {
+        let Some(path) = &self.prior else {
+            return Ok(0);
+        };
+        let AnyMap::Fuzzy(fuzzy) = map else {
+            anyhow::bail!("--prior applies to the fuzzy model only: add --model fuzzy");
+        };
+        let prior = fuzzyvox::io::load_map(path)
+            .with_context(|| format!("reading the prior map {}", path.display()))?;
+        let voxels = fuzzy
+            .add_prior(prior.as_map(), self.prior_confidence)
+            .with_context(|| format!("adding the prior map {}", path.display()))?;
+        tracing::info!(
+            "prior {} ({}): {voxels} voxels at confidence {}",
+            path.display(),
+            prior.model_name(),
+            self.prior_confidence
+        );
+        Ok(voxels)
+    }
+}

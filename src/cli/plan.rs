@@ -2,8 +2,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use fuzzyvox::AnyMap;
 use fuzzyvox::VoxelClass;
+use fuzzyvox::io::load_map;
 use fuzzyvox::plan::{Blocker, PlanError, PlannerConfig, UnknownPolicy, plan_path};
 use serde_json::json;
 
@@ -20,7 +20,7 @@ use serde_json::json;
     ambiguous, low safety, too close to a blocked voxel, or outside the map's observed extent) \
     and a hint with the option that would change it.")]
 pub struct PlanArgs {
-    /// A map file written by `fuzzyvox insert --out`.
+    /// A map file: a fuzzyvox map (`insert --out`), an OctoMap `.bt` or an OctoMap `.ot`.
     #[arg(long)]
     map: PathBuf,
     /// Start as X,Y,Z (metres).
@@ -81,10 +81,10 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         .policy(args.unknown_cost)
         .unwrap_or_else(|e| e.exit());
     let spinner = super::progress::spinner("loading the map", args.json);
-    let map = AnyMap::load(&args.map)?;
+    let map = load_map(&args.map)?;
     tracing::info!(
         "{} map at {} m loaded from {}",
-        map.kind().name(),
+        map.model_name(),
         map.as_map().resolution().size(),
         args.map.display()
     );
@@ -107,7 +107,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
                 // A script gets the reason on standard output too, next to the exit status.
                 super::print_json(&json!({
                     "map": args.map,
-                    "model": map.kind().name(),
+                    "model": map.model_name(),
                     "error": error.to_string(),
                     "failure": failure_name(&error),
                     "reason": error.blocker(),
@@ -125,7 +125,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         let waypoints: Vec<[f64; 3]> = path.waypoints.iter().map(|p| [p.x, p.y, p.z]).collect();
         return super::print_json(&json!({
             "map": args.map,
-            "model": map.kind().name(),
+            "model": map.model_name(),
             "waypoints": waypoints,
             "length_m": path.length,
             "cost": path.cost,

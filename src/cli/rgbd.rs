@@ -9,7 +9,7 @@ use fuzzyvox::{AnyMap, Family, IntegrationOptions};
 use serde_json::json;
 use tracing::{debug, info};
 
-use super::maps::{Evidence, Model, new_map};
+use super::maps::{Evidence, Model, PriorArgs, new_map};
 use super::progress;
 
 /// Map a folder of real RGB-D frames and check each map against frames it has not seen.
@@ -60,6 +60,8 @@ pub struct RgbdArgs {
     /// Number of confidence cuts of the alpha model.
     #[arg(long, default_value_t = 10)]
     cuts: u32,
+    #[command(flatten)]
+    prior: PriorArgs,
     /// Save every map here as MODEL.fvx.
     #[arg(long)]
     save: Option<PathBuf>,
@@ -102,6 +104,7 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
     if !models.contains(&Model::Fuzzy) && args.op != "product" {
         bail!("--op applies to the fuzzy model only");
     }
+    args.prior.check_models(&models)?;
     let check = DepthCheckConfig {
         pixel_step: args.pixel_step,
         max_range: args.cast_range,
@@ -128,9 +131,11 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
     let mut entries: Vec<Entry> = models
         .iter()
         .map(|&model| {
+            let mut map = new_map(model, args.res, family, Evidence::Dual, args.cuts)?;
+            args.prior.apply(&mut map)?;
             Ok(Entry {
                 model,
-                map: new_map(model, args.res, family, Evidence::Dual, args.cuts)?,
+                map,
                 build: Duration::ZERO,
                 predict: Duration::ZERO,
                 errors: DepthErrors::default(),

@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::error::{Error, FormatError, Result};
 use crate::ops::Family;
 
-const MAGIC: &[u8; 8] = b"FUZZYVOX";
+pub(crate) const MAGIC: &[u8; 8] = b"FUZZYVOX";
 const VERSION: u16 = 2;
 /// The oldest version still read. Version 2 added the evidence model's kind and free reach to
 /// fuzzy maps' settings; a version 1 fuzzy map was built with the paper's model and loads as

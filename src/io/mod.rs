@@ -9,6 +9,7 @@ mod atomic;
 mod bounded;
 mod cloud_text;
 mod fuzzy_file;
+mod load;
 mod logodds_file;
 mod mapfile;
 pub mod middlebury;
@@ -22,4 +23,5 @@ pub mod views;
 
 pub use atomic::write_atomic;
 pub use cloud_text::{parse_text_cloud, read_text_cloud};
+pub use load::{LoadedMap, MapFormat, load_map};
 pub use mapfile::{MapHeader, MapKind, read_header};

@@ -97,7 +97,7 @@ impl FuzzyMap {
 
     /// Applies `S` between every cell and the matching cell of `source`, in parallel over
     /// blocks (see [`BlockGrid::update_from`]).
-    fn fold<C: Copy + Default + Sync>(
+    pub(super) fn fold<C: Copy + Default + Sync>(
         &mut self,
         source: &BlockGrid<C>,
         evidence_of: impl Fn(&C) -> (f32, f32) + Sync,

@@ -7,6 +7,7 @@ mod counts;
 mod function;
 mod fuzzy;
 mod logodds;
+mod prior;
 mod raycast;
 
 pub use alpha::{AlphaConfig, AlphaCutMap};
@@ -15,7 +16,9 @@ pub use config::FuzzyConfig;
 pub use counts::VoxelCounts;
 pub use function::FunctionMap;
 pub use fuzzy::FuzzyMap;
+pub(crate) use logodds::logodds as logodds_of;
 pub use logodds::{LogOdds, LogOddsConfig, LogOddsMap};
+pub use prior::MAX_PRIOR_VOXELS;
 pub use raycast::{RayHit, cast_ray};
 
 use nalgebra::Point3;

@@ -25,6 +25,7 @@ use crate::error::{Error, FormatError, Result};
 use crate::storage::VoxelKey;
 
 use super::cursor::Cursor;
+use super::header::parse_header;
 
 /// Depth of OctoMap's tree: leaves at this depth are single voxels.
 pub(super) const TREE_DEPTH: u8 = 16;
@@ -57,19 +58,24 @@ impl BtLeaf {
 
     /// Every voxel of the cube with the leaf's state, in Morton order (x fastest).
     pub fn voxels(&self) -> impl Iterator<Item = (VoxelKey, bool)> + use<> {
-        let BtLeaf { key, occupied, .. } = *self;
-        (0..self.voxel_count()).map(move |m| {
-            let [dx, dy, dz] = deinterleave(m);
-            // Wrapping: hand-built leaves may sit anywhere; decoded ones never come near i32's
-            // limits.
-            let voxel = VoxelKey::new(
-                key.x.wrapping_add(dx),
-                key.y.wrapping_add(dy),
-                key.z.wrapping_add(dz),
-            );
-            (voxel, occupied)
-        })
+        let occupied = self.occupied;
+        cube_keys(self.key, self.side()).map(move |k| (k, occupied))
     }
+}
+
+/// The keys of a cube of `side³` voxels (`side` a power of two) whose lowest corner is `key`, in
+/// Morton order (x fastest).
+pub(super) fn cube_keys(key: VoxelKey, side: u32) -> impl Iterator<Item = VoxelKey> + use<> {
+    (0..u64::from(side).pow(3)).map(move |m| {
+        let [dx, dy, dz] = deinterleave(m);
+        // Wrapping: hand-built leaves may sit anywhere; decoded ones never come near i32's
+        // limits.
+        VoxelKey::new(
+            key.x.wrapping_add(dx),
+            key.y.wrapping_add(dy),
+            key.z.wrapping_add(dz),
+        )
+    })
 }
 
 /// The contents of a `.bt` file: the leaves of OctoMap's max-likelihood tree.
@@ -124,7 +130,13 @@ pub fn read_bt(path: &Path) -> Result<BtMap> {
 /// Like OctoMap, it ignores unknown header keywords and any bytes after the tree. A root without
 /// children is, as OctoMap reads it, one occupied leaf covering all of space.
 pub fn decode_bt(bytes: &[u8]) -> Result<BtMap, FormatError> {
-    let header = parse_header(bytes)?;
+    let header = parse_header(bytes, FILE_HEADER, "an OctoMap binary tree")?;
+    if header.id != "OcTree" && header.id != "1" {
+        return Err(FormatError::WrongKind {
+            expected: "OcTree",
+            found: header.id,
+        });
+    }
     let data = bytes.get(header.data_start..).unwrap_or_default();
     let mut map = BtMap {
         resolution: header.resolution,
@@ -269,121 +281,6 @@ fn deinterleave(m: u64) -> [i32; 3] {
         }
     }
     out
-}
-
-/// What the header says, and where the tree data begins.
-struct Header {
-    size: u64,
-    resolution: f64,
-    data_start: usize,
-}
-
-/// Parses the text header the way OctoMap does: whitespace-separated tokens, `#` comments to the
-/// end of the line, keyword-value pairs, until a `data` token whose line ends the header.
-fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
-    let invalid = |m: String| FormatError::Invalid(m);
-    let first_end = bytes
-        .iter()
-        .position(|&b| b == b'\n')
-        .unwrap_or(bytes.len());
-    if !bytes.starts_with(FILE_HEADER.as_bytes()) {
-        return Err(invalid(format!(
-            "not an OctoMap binary tree: the first line must be `{FILE_HEADER}`"
-        )));
-    }
-    let mut tokens = Tokens {
-        bytes,
-        position: first_end,
-    };
-    let (mut id, mut size, mut resolution) = (None, None, None);
-    loop {
-        let token = tokens
-            .next()
-            .ok_or_else(|| invalid("the header ends without a `data` line".into()))?;
-        match token {
-            b"data" => {
-                tokens.skip_line();
-                break;
-            }
-            b"id" => id = Some(tokens.value("id")?),
-            b"size" => size = Some(tokens.value("size")?),
-            b"res" => resolution = Some(tokens.value("res")?),
-            t if t.starts_with(b"#") => tokens.skip_line(),
-            t if t.iter().all(u8::is_ascii_graphic) => tokens.skip_line(),
-            _ => return Err(invalid("binary bytes in the header before `data`".into())),
-        }
-    }
-    let id = id.ok_or_else(|| invalid("the header has no `id`".into()))?;
-    if id != "OcTree" && id != "1" {
-        return Err(FormatError::WrongKind {
-            expected: "OcTree",
-            found: id,
-        });
-    }
-    let size = size.ok_or_else(|| invalid("the header has no `size`".into()))?;
-    let size: u64 = size
-        .parse()
-        .map_err(|_| invalid(format!("header size `{size}` is not a node count")))?;
-    let resolution = resolution.ok_or_else(|| invalid("the header has no `res`".into()))?;
-    let resolution = resolution
-        .parse::<f64>()
-        .ok()
-        .filter(|r| r.is_finite() && *r > 0.0)
-        .ok_or_else(|| {
-            invalid(format!(
-                "header res `{resolution}` is not a positive length"
-            ))
-        })?;
-    Ok(Header {
-        size,
-        resolution,
-        data_start: tokens.position,
-    })
-}
-
-/// Whitespace-separated tokens of the header.
-struct Tokens<'a> {
-    bytes: &'a [u8],
-    position: usize,
-}
-
-impl<'a> Tokens<'a> {
-    fn rest(&self) -> &'a [u8] {
-        self.bytes.get(self.position..).unwrap_or_default()
-    }
-
-    /// The next token, or `None` at the end of the bytes.
-    fn next(&mut self) -> Option<&'a [u8]> {
-        let rest = self.rest();
-        let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
-        let len = rest
-            .iter()
-            .skip(start)
-            .position(u8::is_ascii_whitespace)
-            .unwrap_or(rest.len() - start);
-        self.position += start + len;
-        rest.get(start..start + len)
-    }
-
-    /// The token after a keyword, as text.
-    fn value(&mut self, keyword: &str) -> Result<String, FormatError> {
-        let token = self.next().unwrap_or_default();
-        match std::str::from_utf8(token) {
-            Ok(text) if !text.is_empty() => Ok(text.to_owned()),
-            _ => Err(FormatError::Invalid(format!(
-                "header keyword `{keyword}` has no readable value"
-            ))),
-        }
-    }
-
-    /// Moves past the next newline (or to the end).
-    fn skip_line(&mut self) {
-        let rest = self.rest();
-        self.position += rest
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(rest.len(), |i| i + 1);
-    }
 }
 
 #[cfg(test)]

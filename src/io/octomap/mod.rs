@@ -32,11 +32,16 @@ mod bt;
 mod bt_write;
 mod cursor;
 mod graph;
+mod header;
 mod log;
+mod ot;
 mod scan;
+mod tree;
 
 pub use bt::{BtLeaf, BtMap, decode_bt, read_bt};
 pub use bt_write::{encode_bt, write_bt, write_bt_max_likelihood};
 pub use graph::{decode_scan_graph, read_scan_graph};
 pub use log::{parse_scan_log, read_scan_log};
+pub use ot::{encode_ot, write_ot};
 pub use scan::ScanNode;
+pub use tree::{OcTreeMap, OctreeFormat, OctreeLeaf};
