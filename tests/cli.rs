@@ -532,6 +532,12 @@ fn printed_plan_examples_work() {
             .skip(1)
             .map(|a| match a {
                 "scan.fvx" => map.to_str().unwrap().to_string(),
+                // OctoMap's own map, wherever the data folder is.
+                other if other.ends_with("octomap-samples/geb079.bt") => data
+                    .join("octomap-samples/geb079.bt")
+                    .to_str()
+                    .unwrap()
+                    .to_string(),
                 other => other.to_string(),
             })
             .collect();

@@ -1,11 +1,23 @@
-//! OctoMap `.bt` files: any bytes give a tree or a typed error; a small decoded tree re-encodes
-//! to a file that decodes to the same voxels.
+//! OctoMap trees, `.bt` and `.ot`: any bytes give a tree or a typed error. A decoded tree answers
+//! every leaf's corner with that leaf and re-encodes as `.ot` to the same leaves; a small `.bt`
+//! tree re-encodes to a file that decodes to the same voxels.
 #![no_main]
 
-use fuzzyvox::io::octomap::{decode_bt, encode_bt};
+use fuzzyvox::io::octomap::{OcTreeMap, decode_bt, encode_bt, encode_ot};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
+    if let Ok(tree) = OcTreeMap::decode(data) {
+        let leaves: Vec<_> = tree.leaves().collect();
+        assert_eq!(leaves.len(), tree.leaf_count());
+        for leaf in leaves.iter().take(256) {
+            assert_eq!(tree.leaf_at(leaf.key), Some(*leaf), "a leaf's corner finds it");
+        }
+        if leaves.len() <= 4096 {
+            let again = OcTreeMap::decode(&encode_ot(&tree)).expect("an encoded tree decodes");
+            assert!(again.leaves().eq(leaves.iter().copied()), ".ot round trip");
+        }
+    }
     let Ok(map) = decode_bt(data) else {
         return;
     };
