@@ -6,7 +6,6 @@
 
 use std::path::PathBuf;
 
-use fuzzyvox::VoxelMap;
 use fuzzyvox::io::load_map;
 use fuzzyvox::plan::{PlannerConfig, plan_path};
 use nalgebra::Point3;
