@@ -293,8 +293,8 @@ fn info_refuses_damaged_empty_and_foreign_files() {
     let out = fuzzyvox(&["export", &map, "--bt", bt.to_str().unwrap()]);
     assert!(out.status.success());
     if Path::new("/dev/zero").exists() {
-        // An endless device: the header's 40 bytes are enough to refuse it.
-        fails(&["info", "/dev/zero"], 1, "not a fuzzyvox map");
+        // An endless device: its first bytes are enough to refuse it.
+        fails(&["info", "/dev/zero"], 1, "not a map file fuzzyvox reads");
         fails(
             &["insert", "--cloud", "/dev/zero", "--res", "0.1"],
             1,
@@ -304,13 +304,17 @@ fn info_refuses_damaged_empty_and_foreign_files() {
     for (path, expected) in [
         (truncated.as_str(), "length mismatch"),
         (flipped.as_str(), "checksum"),
-        (empty.as_str(), "not a fuzzyvox map"),
-        (bt.to_str().unwrap(), "not a fuzzyvox map"),
+        (empty.as_str(), "not a map file fuzzyvox reads"),
         (dir.to_str().unwrap(), "directory"),
         ("/nonexistent/map.fvx", "no such file"),
     ] {
         fails(&["info", path], 1, expected);
     }
+    // OctoMap's own format is a map too.
+    let info = fuzzyvox(&["info", bt.to_str().unwrap(), "--json"]);
+    assert!(info.status.success());
+    let damaged_bt = write(&dir, "damaged.bt", &std::fs::read(&bt).unwrap()[..60]);
+    fails(&["info", &damaged_bt], 1, "damaged.bt");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

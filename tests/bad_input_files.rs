@@ -8,7 +8,8 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::room_scan;
-use fuzzyvox::io::middlebury::{decode_gray_png, parse_calib, read_calib, read_middlebury};
+use fuzzyvox::io::decode_gray_image;
+use fuzzyvox::io::middlebury::{parse_calib, read_calib, read_middlebury};
 use fuzzyvox::io::octomap::{
     decode_bt, decode_scan_graph, encode_bt, parse_scan_log, read_bt, read_scan_graph,
     read_scan_log,
@@ -625,7 +626,7 @@ fn png_truncated_or_bit_flipped_is_a_parse_error() {
             "truncated to {len}"
         );
         assert!(matches!(
-            decode_gray_png(&bytes[..len]),
+            decode_gray_image(&bytes[..len]),
             Err(Error::Parse { .. })
         ));
     }
@@ -648,7 +649,10 @@ fn png_claiming_a_huge_size_is_refused_without_allocating_it() {
             matches!(decode_depth_png_mm(&bytes), Err(Error::Parse { .. })),
             "{w}×{h}"
         );
-        assert!(matches!(decode_gray_png(&bytes), Err(Error::Parse { .. })));
+        assert!(matches!(
+            decode_gray_image(&bytes),
+            Err(Error::Parse { .. })
+        ));
     }
 }
 

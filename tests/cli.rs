@@ -125,7 +125,7 @@ fn errors_are_clear_and_exit_non_zero() {
         ),
         (
             vec!["info", not_a_map.to_str().unwrap()],
-            "not a fuzzyvox map",
+            "not a map file fuzzyvox reads",
         ),
     ];
     for (args, expected) in cases {

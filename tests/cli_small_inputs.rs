@@ -222,7 +222,7 @@ fn export_writes_several_outputs_at_once_and_rejects_bad_requests() {
     fails(
         &["export", not_a_map.to_str().unwrap(), "--png", out],
         1,
-        "not a fuzzyvox map",
+        "not a map file fuzzyvox reads",
     );
     fails(&["info", "/nonexistent/map.fvx"], 1, "/nonexistent/map.fvx");
     std::fs::remove_dir_all(&dir).unwrap();

@@ -2,7 +2,7 @@
 //! image or a typed error; a depth image turns into an interval image.
 #![no_main]
 
-use fuzzyvox::io::middlebury::decode_gray_png;
+use fuzzyvox::io::decode_gray_image;
 use fuzzyvox::io::rgbd::{decode_depth_png_mm, kinect_interval_image};
 use libfuzzer_sys::fuzz_target;
 
@@ -14,7 +14,7 @@ fuzz_target!(|data: &[u8]| {
         );
         kinect_interval_image(&depth).expect("millimetre depth gives valid intervals");
     }
-    if let Ok(gray) = decode_gray_png(data) {
+    if let Ok(gray) = decode_gray_image(data) {
         assert_eq!(
             gray.pixels().len(),
             gray.width() as usize * gray.height() as usize

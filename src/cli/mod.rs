@@ -4,10 +4,12 @@
 mod demo;
 mod eval;
 mod export;
+mod held_out;
 mod info;
 mod input;
 mod insert;
 mod maps;
+mod mono;
 mod plan;
 pub mod progress;
 mod rgbd;
@@ -32,6 +34,7 @@ use clap::{Parser, Subcommand};
         fuzzyvox export scan.fvx --png top.png --ply scan.ply --bt scan.bt\n  \
         fuzzyvox plan --map scan.fvx --from 3,0,0.5 --to 7,-11,0.5\n  \
         fuzzyvox rgbd --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.02\n  \
+        fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04\n  \
         fuzzyvox stereo --middlebury ../shared/data/middlebury-motorcycle --json\n\n\
         Every command has --help with its own examples; -v, -vv log more to standard error."
 )]
@@ -54,6 +57,7 @@ enum Command {
     Stereo(stereo::StereoArgs),
     Simulate(simulate::SimulateArgs),
     Rgbd(rgbd::RgbdArgs),
+    Mono(mono::MonoArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -70,6 +74,7 @@ pub fn run() -> ExitCode {
         Command::Stereo(args) => stereo::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Rgbd(args) => rgbd::run(args),
+        Command::Mono(args) => mono::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,8 +5,9 @@ use clap::{Args, ValueEnum};
 use fuzzyvox::depth::{
     Accuracy, DepthParams, GrayImage, IntervalMethod, depth_from_rectified, evaluate,
 };
-use fuzzyvox::io::middlebury::{read_calib, read_gray_png};
+use fuzzyvox::io::middlebury::read_calib;
 use fuzzyvox::io::pfm::{read_pfm, write_pfm};
+use fuzzyvox::io::read_gray_image;
 use serde_json::json;
 
 /// Match a rectified stereo pair into disparity, interval depth and confidence.
@@ -85,8 +86,8 @@ pub fn run(args: StereoArgs) -> anyhow::Result<()> {
     let right_path = pick(&args.right, "im1.png")?;
     let calib_path = pick(&args.calib, "calib.txt")?;
     let calib = read_calib(&calib_path)?;
-    let left = read_gray_png(&left_path)?;
-    let right = read_gray_png(&right_path)?;
+    let left = read_gray_image(&left_path)?;
+    let right = read_gray_image(&right_path)?;
     let geometry = calib.geometry()?;
     if left.width() != calib.width || left.height() != calib.height {
         bail!(

@@ -15,6 +15,7 @@ mod pipeline;
 mod quality;
 mod rectify;
 mod scan;
+mod stream;
 mod sweep;
 mod views;
 
@@ -36,5 +37,6 @@ pub use pipeline::{
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
 pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry, UnrectifiableReason};
+pub use stream::{DepthStream, SkipReason, StreamCounts};
 pub use sweep::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
 pub use views::ViewWindow;

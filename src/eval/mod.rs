@@ -12,6 +12,7 @@
 //! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
 //! ray-casting them into held-out frames.
 
+mod depth_stage;
 mod experiment;
 mod figures;
 mod flights;
@@ -20,6 +21,7 @@ mod report;
 mod rgbd;
 mod truth;
 
+pub use depth_stage::{DepthStageErrors, DepthStageSummary};
 pub use experiment::{
     DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport, run_experiment,
     run_experiment_with_progress,

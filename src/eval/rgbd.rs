@@ -200,7 +200,7 @@ impl DepthErrors {
 }
 
 /// The median of `values` (NaN when empty).
-fn median(mut values: Vec<f32>) -> f64 {
+pub(super) fn median(mut values: Vec<f32>) -> f64 {
     values.sort_by(f32::total_cmp);
     match values.len() {
         0 => f64::NAN,

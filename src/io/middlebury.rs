@@ -6,6 +6,7 @@ use std::path::Path;
 
 use nalgebra::Isometry3;
 
+use super::gray::read_gray_image;
 use super::pfm::{FloatImage, read_pfm};
 use crate::depth::{GrayImage, StereoGeometry};
 use crate::error::{Error, Result};
@@ -119,43 +120,6 @@ fn calib_from(bytes: &[u8], path: &Path) -> Result<MiddleburyCalib> {
     })
 }
 
-/// Reads an 8-bit grayscale or RGB(A) PNG as a [`GrayImage`].
-pub fn read_gray_png(path: &Path) -> Result<GrayImage> {
-    let reader = image::ImageReader::open(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    gray_from(reader, path)
-}
-
-/// Decodes an 8-bit grayscale or RGB(A) PNG held in memory; see [`read_gray_png`]. Errors name
-/// the path `<memory>`.
-pub fn decode_gray_png(bytes: &[u8]) -> Result<GrayImage> {
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-    gray_from(reader, Path::new("<memory>"))
-}
-
-fn gray_from<R: std::io::BufRead + std::io::Seek>(
-    reader: image::ImageReader<R>,
-    path: &Path,
-) -> Result<GrayImage> {
-    let decoded = reader
-        .with_guessed_format()
-        .map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?
-        .decode()
-        .map_err(|e| Error::Parse {
-            path: path.to_path_buf(),
-            line: 0,
-            message: format!("not a readable image: {e}"),
-        })?;
-    let rgb = decoded.to_rgb8();
-    let (width, height) = rgb.dimensions();
-    GrayImage::from_rgb8(width, height, rgb.as_raw())
-}
-
 /// A Middlebury pair with its calibration and, when present, ground truth.
 #[derive(Clone, Debug)]
 pub struct MiddleburyPair {
@@ -171,8 +135,8 @@ pub struct MiddleburyPair {
 
 /// Reads a Middlebury folder; the images must have the calibrated size.
 pub fn read_middlebury(dir: &Path) -> Result<MiddleburyPair> {
-    let left = read_gray_png(&dir.join("im0.png"))?;
-    let right = read_gray_png(&dir.join("im1.png"))?;
+    let left = read_gray_image(&dir.join("im0.png"))?;
+    let right = read_gray_image(&dir.join("im1.png"))?;
     let calib = read_calib(&dir.join("calib.txt"))?;
     for (what, image) in [("im0.png pixels", &left), ("im1.png pixels", &right)] {
         if image.width() != calib.width || image.height() != calib.height {

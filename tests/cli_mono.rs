@@ -1,0 +1,308 @@
+//! `fuzzyvox mono`: maps from posed colour images through the one-camera depth stage, on a
+//! simulated posed folder (the wall scenario as `fuzzyvox simulate` writes it) and, with
+//! `FUZZYVOX_DATA`, on real 7-Scenes frames.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{data_dir, fuzzyvox, json};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_mono")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The wall scenario's 24 frames in the RGB-D layout, with true depth.
+fn simulated(name: &str) -> PathBuf {
+    let dir = scratch(name).join("frames");
+    json(&fuzzyvox(&[
+        "simulate",
+        "--scenario",
+        "wall",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]));
+    dir
+}
+
+fn mono(dir: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "mono",
+        "--dir",
+        dir.to_str().unwrap(),
+        "--res",
+        "0.2",
+        "--near",
+        "1",
+        "--far",
+        "40",
+        "--holdout",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    json(&fuzzyvox(&args))
+}
+
+fn map_bytes(dir: &Path) -> Vec<Vec<u8>> {
+    ["logodds", "alpha", "fuzzy"]
+        .iter()
+        .map(|m| std::fs::read(dir.join(format!("{m}.fvx"))).unwrap())
+        .collect()
+}
+
+#[test]
+fn mono_maps_simulated_frames_deterministically_without_sensor_depth() {
+    let frames = simulated("deterministic");
+    let root = frames.parent().unwrap().to_path_buf();
+    let first = mono(&frames, &root.join("maps-1"), &[]);
+    assert_eq!(first["frames"], 24);
+    assert_eq!(first["build_frames"], 18);
+    assert_eq!(first["held_out_checked"], 6);
+    let images = first["depth_images"].as_u64().unwrap();
+    assert!(images >= 10, "{first}");
+    assert!(first["rectified"].as_u64().unwrap() > 0);
+    assert!(
+        first["swept"].as_u64().unwrap() > 0,
+        "the receding phase is swept"
+    );
+    let skipped: u64 = first["skipped"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(images + skipped, 18, "{first}");
+    // The depth stage on clean rendered images: close to the truth, intervals that hold it.
+    let stage = &first["depth_stage"];
+    assert!(
+        stage["median_rel_error_top50"].as_f64().unwrap() < 0.05,
+        "{stage}"
+    );
+    assert!(
+        stage["interval_coverage_top50"].as_f64().unwrap() > 0.9,
+        "{stage}"
+    );
+    assert!(stage["share_of_mapping_time"].as_f64().unwrap() > 0.0);
+    let models: Vec<&str> = first["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["model"].as_str().unwrap())
+        .collect();
+    assert_eq!(models, ["logodds", "alpha", "fuzzy"]);
+    for m in first["maps"].as_array().unwrap() {
+        assert!(m["within_2_voxels"].as_f64().unwrap() > 0.1, "{m}");
+    }
+
+    // The same run again gives the same maps, byte for byte, and the same figures.
+    let second = mono(&frames, &root.join("maps-2"), &[]);
+    assert_eq!(
+        map_bytes(&root.join("maps-1")),
+        map_bytes(&root.join("maps-2"))
+    );
+    for key in ["depth_images", "skipped", "maps"] {
+        let strip = |v: &serde_json::Value| {
+            let mut v = v.clone();
+            if let Some(maps) = v.as_array_mut() {
+                for m in maps {
+                    m["build_seconds"] = 0.into();
+                    m["predict_seconds"] = 0.into();
+                }
+            }
+            v
+        };
+        assert_eq!(strip(&first[key]), strip(&second[key]), "{key}");
+    }
+    assert_eq!(
+        first["depth_stage"]["median_rel_error"],
+        second["depth_stage"]["median_rel_error"]
+    );
+
+    // Sensor depth never reaches the maps: without the depth files, the same maps.
+    let bare = root.join("no-depth");
+    std::fs::create_dir_all(&bare).unwrap();
+    for entry in std::fs::read_dir(&frames).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_str().unwrap().to_string();
+        if !name.ends_with(".depth.png") {
+            std::fs::copy(&path, bare.join(&name)).unwrap();
+        }
+    }
+    let without = mono(&bare, &root.join("maps-3"), &[]);
+    assert_eq!(
+        map_bytes(&root.join("maps-1")),
+        map_bytes(&root.join("maps-3"))
+    );
+    assert_eq!(without["held_out_checked"], 0);
+    assert_eq!(without["depth_stage"]["pixels"], 0);
+
+    // Poses from a TUM trajectory (the same poses as quaternions, k-th line for the k-th frame,
+    // the same times) give the same pairs and nearly the same maps: rotations rounded through
+    // quaternions move some matches by a disparity step.
+    let mut names: Vec<String> = std::fs::read_dir(&bare)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_str().unwrap().to_string())
+        .filter(|n| n.ends_with(".pose.txt"))
+        .collect();
+    names.sort();
+    let mut tum = String::from("# timestamp tx ty tz qx qy qz qw\n");
+    for (k, name) in names.iter().enumerate() {
+        let pose = fuzzyvox::io::rgbd::read_pose_txt(&bare.join(name)).unwrap();
+        let (t, q) = (pose.translation.vector, pose.rotation.quaternion());
+        tum.push_str(&format!(
+            "{} {} {} {} {} {} {} {}\n",
+            k as f64 / 30.0,
+            t.x,
+            t.y,
+            t.z,
+            q.i,
+            q.j,
+            q.k,
+            q.w
+        ));
+        std::fs::remove_file(bare.join(name)).unwrap();
+    }
+    let trajectory = root.join("poses.tum");
+    std::fs::write(&trajectory, tum).unwrap();
+    let from_tum = mono(
+        &bare,
+        &root.join("maps-4"),
+        &["--trajectory", trajectory.to_str().unwrap()],
+    );
+    assert_eq!(from_tum["depth_images"], first["depth_images"]);
+    assert_eq!(from_tum["skipped"], first["skipped"]);
+    let fuzzy = |dir: &Path| {
+        fuzzyvox::FuzzyMap::load(dir.join("fuzzy.fvx"))
+            .unwrap()
+            .counts()
+    };
+    let (a, b) = (fuzzy(&root.join("maps-4")), fuzzy(&root.join("maps-1")));
+    for (x, y) in [(a.occupied, b.occupied), (a.free, b.free)] {
+        assert!(x.abs_diff(y) * 10 <= y, "{a:?} against {b:?}");
+    }
+}
+
+#[test]
+fn mono_refuses_bad_folders_and_options_clearly() {
+    let frames = simulated("refusals");
+    let root = frames.parent().unwrap().to_path_buf();
+    let fails = |args: &[&str], says: &str| {
+        let out = fuzzyvox(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    };
+    let dir = frames.to_str().unwrap();
+    fails(
+        &[
+            "mono", "--dir", dir, "--res", "0.2", "--near", "5", "--far", "2",
+        ],
+        "0 < near < far",
+    );
+    fails(
+        &["mono", "--dir", dir, "--res", "0.2", "--holdout", "1"],
+        "--holdout 1",
+    );
+    let empty = root.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    fails(
+        &["mono", "--dir", empty.to_str().unwrap(), "--res", "0.2"],
+        "frame-N.color.png",
+    );
+    // A frame without its pose.
+    let broken = root.join("broken");
+    std::fs::create_dir_all(&broken).unwrap();
+    for name in [
+        "camera-intrinsics.txt",
+        "frame-000000.color.png",
+        "frame-000001.color.png",
+    ] {
+        std::fs::copy(frames.join(name), broken.join(name)).unwrap();
+    }
+    std::fs::copy(
+        frames.join("frame-000000.pose.txt"),
+        broken.join("frame-000000.pose.txt"),
+    )
+    .unwrap();
+    fails(
+        &["mono", "--dir", broken.to_str().unwrap(), "--res", "0.2"],
+        "frame-000001.pose.txt",
+    );
+    // A trajectory of the wrong length, or with a bad line.
+    let short = root.join("short.tum");
+    std::fs::write(&short, "0 0 0 0 0 0 0 1\n").unwrap();
+    let args = |t: &Path| {
+        vec![
+            "mono".to_string(),
+            "--dir".into(),
+            dir.into(),
+            "--res".into(),
+            "0.2".into(),
+            "--trajectory".into(),
+            t.to_str().unwrap().into(),
+        ]
+    };
+    let run = |t: &Path, says: &str| {
+        let owned = args(t);
+        let refs: Vec<&str> = owned.iter().map(String::as_str).collect();
+        fails(&refs, says);
+    };
+    run(&short, "trajectory poses");
+    let bad = root.join("bad.tum");
+    std::fs::write(&bad, "0 0 0 0 0 0 0 1\n1 0 0 nan 0 0 0 1\n").unwrap();
+    run(&bad, "bad.tum:2");
+    let unnormalised = root.join("unnormalised.tum");
+    std::fs::write(&unnormalised, "0 0 0 0 0 0 0 2\n").unwrap();
+    run(&unnormalised, "quaternion");
+}
+
+#[test]
+fn mono_on_real_frames_reports_the_depth_stage() {
+    let Some(data) = data_dir("mono_on_real_frames_reports_the_depth_stage") else {
+        return;
+    };
+    let dir = data.join("rgbd-7scenes-redkitchen");
+    let out = scratch("real");
+    let report = json(&fuzzyvox(&[
+        "mono",
+        "--dir",
+        dir.to_str().unwrap(),
+        "--res",
+        "0.05",
+        "--model",
+        "logodds",
+        "--pixel-step",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["frames"], 50);
+    assert_eq!(report["held_out_checked"], 10);
+    // The colour camera's own K was read.
+    assert!(
+        report["color_intrinsics"]
+            .as_str()
+            .unwrap()
+            .ends_with("color-intrinsics.txt")
+    );
+    let stage = &report["depth_stage"];
+    assert!(stage["pixels"].as_u64().unwrap() > 100_000, "{stage}");
+    // The confidence ranks the depth: the confident half is more accurate than all pixels.
+    assert!(
+        stage["median_rel_error_top50"].as_f64().unwrap()
+            < stage["median_rel_error"].as_f64().unwrap(),
+        "{stage}"
+    );
+    assert!(report["frames_per_second"].as_f64().unwrap() > 0.0);
+}
