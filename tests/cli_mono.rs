@@ -306,3 +306,69 @@ fn mono_on_real_frames_reports_the_depth_stage() {
     );
     assert!(report["frames_per_second"].as_f64().unwrap() > 0.0);
 }
+
+#[test]
+fn mono_reads_jpeg_and_16_bit_frames() {
+    let frames = simulated("jpeg");
+    let root = frames.parent().unwrap().to_path_buf();
+    let png = mono(&frames, &root.join("maps-png"), &[]);
+    // The same frames as JPEG (quality 95) for even frame numbers and 16-bit grey PNG for odd.
+    let converted = root.join("converted");
+    std::fs::create_dir_all(&converted).unwrap();
+    for entry in std::fs::read_dir(&frames).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_str().unwrap().to_string();
+        let Some(stem) = name.strip_suffix(".color.png") else {
+            std::fs::copy(&path, converted.join(&name)).unwrap();
+            continue;
+        };
+        let gray = image::open(&path).unwrap().to_luma8();
+        let number: u32 = stem.trim_start_matches("frame-").parse().unwrap();
+        if number.is_multiple_of(2) {
+            let file = std::fs::File::create(converted.join(format!("{stem}.color.jpg"))).unwrap();
+            let mut encoder = image::codecs::jpeg::JpegEncoder::new_with_quality(
+                std::io::BufWriter::new(file),
+                95,
+            );
+            encoder.encode_image(&gray).unwrap();
+        } else {
+            let wide = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(
+                gray.width(),
+                gray.height(),
+                |x, y| image::Luma([u16::from(gray.get_pixel(x, y)[0]) * 257]),
+            );
+            wide.save(converted.join(&name)).unwrap();
+        }
+    }
+    let mixed = mono(&converted, &root.join("maps-mixed"), &[]);
+    assert_eq!(mixed["frames"], 24);
+    assert_eq!(mixed["skipped"], png["skipped"], "{mixed}");
+    let stage = &mixed["depth_stage"];
+    assert!(
+        stage["median_rel_error_top50"].as_f64().unwrap() < 0.05,
+        "{stage}"
+    );
+    // Anything else is refused, naming the file.
+    let bad = root.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    for entry in std::fs::read_dir(&frames).unwrap() {
+        let path = entry.unwrap().path();
+        std::fs::copy(&path, bad.join(path.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(bad.join("frame-000003.color.png"), b"GIF89a not really").unwrap();
+    let out = fuzzyvox(&[
+        "mono",
+        "--dir",
+        bad.to_str().unwrap(),
+        "--res",
+        "0.2",
+        "--near",
+        "1",
+        "--far",
+        "40",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("frame-000003.color.png"), "{stderr}");
+    assert!(stderr.contains("not a readable image"), "{stderr}");
+}
