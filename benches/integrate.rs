@@ -4,6 +4,7 @@
 //! Needs `FUZZYVOX_DATA` (the shared data folder); without it the benchmarks say so and skip.
 //! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench integrate`.
 
+use fuzzyvox::VoxelMapMut;
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};

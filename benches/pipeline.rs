@@ -8,11 +8,12 @@
 //! Run: `cargo bench --bench pipeline`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::depth::{
     DepthParams, ForwardMotion, Frame, MatchMethod, ViewWindow, depth_from_pair,
 };
 use fuzzyvox::sim::scenario;
-use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, VoxelMap};
+use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions};
 
 /// Every pair of a 40-pair random flight, its views and how the depth stage matches it.
 fn frames(params: &DepthParams) -> Vec<(Frame, Frame, Option<MatchMethod>)> {

@@ -7,6 +7,7 @@
 //!
 //! Run: `cargo run --release --example compare_operators`
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::{
     Family, FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, TConorm, VoxelClass, VoxelMap,
 };

@@ -7,6 +7,7 @@
 //!
 //! Run: `cargo run --release --example depth_from_two_images [-- ../shared/data/middlebury-motorcycle]`
 
+use fuzzyvox::VoxelMapMut;
 use std::path::PathBuf;
 
 use fuzzyvox::depth::{DepthParams, GrayImage, StereoGeometry, depth_from_rectified};

@@ -13,9 +13,10 @@
 //! Arguments: total points (default 10,000,000), points per chunk (default 100,000), resolution
 //! in metres (default 0.1).
 
+use fuzzyvox::VoxelMapMut;
 use std::time::Instant;
 
-use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap};
+use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud};
 use nalgebra::{Point3, Vector3};
 
 /// SplitMix64: a small deterministic generator, so the example needs no extra crate.

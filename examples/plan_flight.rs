@@ -3,6 +3,7 @@
 //!
 //! Run: `cargo run --release --example plan_flight`
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::plan::{PlannerConfig, plan_path};
 use fuzzyvox::{
     FuzzyConfig, FuzzyMap, IntegrationOptions, LogOddsConfig, LogOddsMap, PointCloud, VoxelMap,

@@ -3,6 +3,7 @@
 //!
 //! Run: `cargo run --release --example quickstart`
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap};
 use nalgebra::Point3;
 

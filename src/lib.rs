@@ -16,7 +16,7 @@
 //! - the dual-set [`FuzzyMap`] with its [`Measures`], merge, and crash-safe files.
 //!
 //! ```
-//! use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap};
+//! use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap, VoxelMapMut};
 //! use nalgebra::Point3;
 //!
 //! let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
@@ -67,7 +67,7 @@ pub use integrate::{
 };
 pub use map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
-    VoxelCounts, VoxelMap,
+    VoxelCounts, VoxelMap, VoxelMapMut,
 };
 pub use measures::{ClassThresholds, MeasureConfig, Measures, Memberships, VoxelClass};
 pub use ops::{Complement, Family, Hedge, TConorm, TNorm};

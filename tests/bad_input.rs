@@ -4,9 +4,10 @@
 mod common;
 
 use common::{room_scan, wall_frame};
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::{
     DepthFrame, Error, Family, FormatError, FuzzyConfig, FuzzyMap, IntegrationOptions,
-    IntervalDepthImage, PinholeIntrinsics, PointCloud, TConorm, VoxelMap,
+    IntervalDepthImage, PinholeIntrinsics, PointCloud, TConorm,
 };
 use nalgebra::{Isometry3, Matrix4, Point3, Quaternion, Translation3, UnitQuaternion};
 

@@ -5,6 +5,7 @@
 
 mod common;
 
+use fuzzyvox::VoxelMapMut;
 use std::path::{Path, PathBuf};
 
 use common::room_scan;
@@ -21,7 +22,7 @@ use fuzzyvox::io::rgbd::{
 use fuzzyvox::io::{parse_text_cloud, read_header, read_text_cloud};
 use fuzzyvox::{
     AlphaConfig, AlphaCutMap, AnyMap, Error, FormatError, FuzzyConfig, FuzzyMap, LogOddsConfig,
-    LogOddsMap, VoxelKey, VoxelMap,
+    LogOddsMap, VoxelKey,
 };
 use nalgebra::Point3;
 

@@ -6,6 +6,7 @@
 mod common;
 
 use common::{room_scan, wall_frame};
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::depth::{
     DepthParams, Frame, GrayImage, IntervalMethod, IntervalParams, MatchParams,
     UnrectifiableReason, depth_from_pair, match_pair,
@@ -37,7 +38,7 @@ fn mapped() -> Vec<AnyMap> {
 /// Runs `f` on each mapped map, expects an error from every one, checks every map's bytes are
 /// unchanged, and returns the errors.
 fn fails_unchanged_in_every_map(
-    mut f: impl FnMut(&mut dyn VoxelMap) -> fuzzyvox::Result<fuzzyvox::IntegrationStats>,
+    mut f: impl FnMut(&mut dyn VoxelMapMut) -> fuzzyvox::Result<fuzzyvox::IntegrationStats>,
 ) -> Vec<Error> {
     mapped()
         .into_iter()
@@ -58,7 +59,7 @@ fn fails_unchanged_in_every_map(
 /// Like [`fails_unchanged_in_every_map`], for calls that succeed without changing anything.
 fn succeeds_unchanged_in(
     maps: Vec<AnyMap>,
-    mut f: impl FnMut(&mut dyn VoxelMap) -> fuzzyvox::Result<fuzzyvox::IntegrationStats>,
+    mut f: impl FnMut(&mut dyn VoxelMapMut) -> fuzzyvox::Result<fuzzyvox::IntegrationStats>,
 ) -> Vec<fuzzyvox::IntegrationStats> {
     maps.into_iter()
         .map(|mut map| {

@@ -4,6 +4,7 @@
 mod common;
 
 use common::{data_dir, room_scan, wall_frame};
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::io::read_text_cloud;
 use fuzzyvox::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, IntegrationOptions, LogOddsConfig,

@@ -3,6 +3,7 @@
 
 mod common;
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::depth::{
     DepthParams, ForwardMotion, Frame, GrayImage, IntervalMethod, MatchMethod, MatchParams,
     PairCriteria, PairSelector, Rectification, Side, UnrectifiableReason, depth_by_plane_sweep,

@@ -3,6 +3,7 @@
 //! evidence does not depend on the interval's width or the confidence; point clouds the same.
 //! The paper's model, kept for comparison, is checked beside it.
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::integrate::depth_evidence;
 use fuzzyvox::storage::Resolution;
 use fuzzyvox::{

@@ -4,6 +4,7 @@
 mod common;
 
 use common::{room_scan, wall_frame};
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::{
     EvidenceKind, EvidenceModel, Family, FuzzyConfig, FuzzyMap, IntegrationOptions, Memberships,
     TConorm, VoxelClass, VoxelMap,

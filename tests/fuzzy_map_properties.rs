@@ -2,6 +2,7 @@
 //! (exactly) and associative (to float tolerance), insertion order does not matter, and
 //! memberships stay in [0, 1], for several operator families.
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::{Family, FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, TConorm, VoxelMap};
 use nalgebra::Point3;
 use proptest::prelude::*;

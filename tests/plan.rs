@@ -1,5 +1,6 @@
 //! Planning: cost field, A* through petgraph's traits, shortcutting, typed failures, queries.
 
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::map::FunctionMap;
 use fuzzyvox::plan::{
     CostField, PlanError, PlannerConfig, PlanningRegion, SafetyQueries, UnknownPolicy, VoxelGraph,

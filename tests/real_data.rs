@@ -5,6 +5,7 @@
 mod common;
 
 use common::data_dir;
+use fuzzyvox::VoxelMapMut;
 use fuzzyvox::io::read_text_cloud;
 use fuzzyvox::io::rgbd::{
     kinect_interval_image, read_depth_png_mm, read_intrinsics_txt, read_pose_txt,

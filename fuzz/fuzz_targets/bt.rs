@@ -11,7 +11,11 @@ fuzz_target!(|data: &[u8]| {
         let leaves: Vec<_> = tree.leaves().collect();
         assert_eq!(leaves.len(), tree.leaf_count());
         for leaf in leaves.iter().take(256) {
-            assert_eq!(tree.leaf_at(leaf.key), Some(*leaf), "a leaf's corner finds it");
+            assert_eq!(
+                tree.leaf_at(leaf.key),
+                Some(*leaf),
+                "a leaf's corner finds it"
+            );
         }
         if leaves.len() <= 4096 {
             let again = OcTreeMap::decode(&encode_ot(&tree)).expect("an encoded tree decodes");

@@ -11,7 +11,7 @@ use arbitrary::Arbitrary;
 use common::{Metres, Operator, Pose, Resolution};
 use fuzzyvox::{
     AlphaConfig, AlphaCutMap, DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions,
-    IntervalDepthImage, LogOddsConfig, LogOddsMap, PinholeIntrinsics, PointCloud, VoxelMap,
+    IntervalDepthImage, LogOddsConfig, LogOddsMap, PinholeIntrinsics, PointCloud, VoxelMapMut,
 };
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Point3;
@@ -161,7 +161,7 @@ fuzz_target!(|input: Input| {
 });
 
 /// Integrates a small fixed scan, then the frame: an error must leave the bytes unchanged.
-fn check<M: VoxelMap>(
+fn check<M: VoxelMapMut>(
     mut map: M,
     frame: &DepthFrame,
     options: &IntegrationOptions,

@@ -10,7 +10,7 @@ use arbitrary::Arbitrary;
 use common::{Metres, Operator, Resolution};
 use fuzzyvox::{
     AlphaConfig, AlphaCutMap, FuzzyConfig, FuzzyMap, IntegrationOptions, LogOddsConfig, LogOddsMap,
-    PointCloud, VoxelMap,
+    PointCloud, VoxelMapMut,
 };
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Point3;
@@ -101,7 +101,7 @@ fuzz_target!(|input: Input| {
 });
 
 /// Integrates a small fixed scan, then the input: an error must leave the bytes unchanged.
-fn check<M: VoxelMap>(
+fn check<M: VoxelMapMut>(
     mut map: M,
     cloud: &PointCloud,
     options: &IntegrationOptions,

@@ -4,7 +4,7 @@
 //! small scan.
 #![no_main]
 
-use fuzzyvox::{AlphaCutMap, FuzzyMap, LogOddsMap, PointCloud, VoxelMap};
+use fuzzyvox::{AlphaCutMap, FuzzyMap, LogOddsMap, PointCloud, VoxelMapMut};
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Point3;
 
@@ -46,7 +46,7 @@ fn check(bytes: &[u8]) {
 }
 
 /// Queries the loaded map and integrates a three-voxel ray into it.
-fn exercise(mut map: impl VoxelMap) {
+fn exercise(mut map: impl VoxelMapMut) {
     let counts = map.counts();
     let _ = counts;
     for (_, m) in map.cells().take(4096) {

@@ -1,6 +1,7 @@
 //! The experiment runner: one scenario, identical depth-stage output fed to every map, metrics
 //! after every phase.
 
+use crate::map::VoxelMapMut;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -17,7 +18,7 @@ use crate::depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
 use crate::error::{Error, Result};
 use crate::integrate::{DepthFrame, EvidenceModel, IntegrationOptions, IntervalDepthImage};
 use crate::map::{
-    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, VoxelMap,
+    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
 };
 use crate::ops::{Family, TConorm};
 use crate::sim::scenario::Scenario;

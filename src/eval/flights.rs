@@ -304,6 +304,7 @@ pub fn summarize(outcomes: &[FlightOutcome], reference: &[FlightOutcome]) -> Fli
 mod tests {
     use super::*;
     use crate::PointCloud;
+    use crate::map::VoxelMapMut;
     use crate::map::{FuzzyConfig, FuzzyMap};
     use crate::sim::SurfaceKind;
     use nalgebra::Vector3;

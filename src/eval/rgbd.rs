@@ -240,6 +240,7 @@ mod tests {
     use super::*;
     use crate::integrate::{IntegrationOptions, IntervalDepthImage};
     use crate::io::rgbd::kinect_interval_image;
+    use crate::map::VoxelMapMut;
     use crate::map::{FuzzyConfig, FuzzyMap};
     use crate::{DepthFrame, PinholeIntrinsics};
     use nalgebra::{Isometry3, Translation3, UnitQuaternion};

@@ -1,3 +1,4 @@
+use crate::map::VoxelMapMut;
 use nalgebra::Isometry3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;

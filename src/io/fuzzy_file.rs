@@ -118,7 +118,7 @@ mod tests {
             vec![nalgebra::Point3::new(1.0, 0.5, 0.0)],
         )
         .unwrap();
-        crate::VoxelMap::integrate_cloud(&mut map, &cloud, &Default::default()).unwrap();
+        crate::VoxelMapMut::integrate_cloud(&mut map, &cloud, &Default::default()).unwrap();
         let old = BodyV1 {
             config: ConfigV1 {
                 resolution: config.resolution,

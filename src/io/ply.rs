@@ -41,7 +41,7 @@ pub fn class_color(class: VoxelClass) -> [u8; 3] {
 ///
 /// ```
 /// use fuzzyvox::io::ply::{PlyEncoding, write_ply};
-/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap};
+/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap, VoxelMapMut};
 /// use nalgebra::Point3;
 ///
 /// let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
@@ -116,6 +116,7 @@ pub fn write_ply(
 mod tests {
     use super::*;
     use crate::integrate::{IntegrationOptions, PointCloud};
+    use crate::map::VoxelMapMut;
     use crate::map::{FuzzyConfig, FuzzyMap};
     use nalgebra::Point3;
 

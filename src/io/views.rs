@@ -54,7 +54,7 @@ pub const MAX_VIEW_SIDE: u32 = 16_384;
 ///
 /// ```
 /// use fuzzyvox::io::views::{View, ViewColor, render_view};
-/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap};
+/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap, VoxelMapMut};
 /// use nalgebra::Point3;
 ///
 /// let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
@@ -222,6 +222,7 @@ fn ramp(value: f32) -> [u8; 3] {
 mod tests {
     use super::*;
     use crate::integrate::{IntegrationOptions, PointCloud};
+    use crate::map::VoxelMapMut;
     use crate::map::{FuzzyConfig, FuzzyMap, VoxelMap};
     use nalgebra::Point3;
 

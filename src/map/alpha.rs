@@ -1,8 +1,8 @@
 use serde::{Deserialize, Serialize};
 
-use super::VoxelMap;
 use super::counts::VoxelCounts;
 use super::logodds::{LogOddsConfig, LogOddsMap, logodds};
+use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
 use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, scan_levels};
 use crate::measures::{MeasureConfig, Memberships};
@@ -115,6 +115,20 @@ impl VoxelMap for AlphaCutMap {
         self.inner.memberships_at(key)
     }
 
+    fn counts(&self) -> VoxelCounts {
+        self.inner.counts()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.inner.memory_bytes()
+    }
+
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
+        self.inner.cells()
+    }
+}
+
+impl VoxelMapMut for AlphaCutMap {
     fn integrate_cloud(
         &mut self,
         cloud: &PointCloud,
@@ -138,18 +152,6 @@ impl VoxelMap for AlphaCutMap {
         options: &IntegrationOptions,
     ) -> Result<IntegrationStats> {
         self.integrate_cloud(&frame.to_cloud()?, options)
-    }
-
-    fn counts(&self) -> VoxelCounts {
-        self.inner.counts()
-    }
-
-    fn memory_bytes(&self) -> usize {
-        self.inner.memory_bytes()
-    }
-
-    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
-        self.inner.cells()
     }
 }
 

@@ -1,6 +1,6 @@
 use std::path::Path;
 
-use super::{AlphaCutMap, FuzzyMap, LogOddsMap, VoxelMap};
+use super::{AlphaCutMap, FuzzyMap, LogOddsMap, VoxelMap, VoxelMapMut};
 use crate::error::Result;
 use crate::io::{MapKind, read_header};
 
@@ -63,7 +63,7 @@ impl AnyMap {
     }
 
     /// The map through the interface every map implements, for integration.
-    pub fn as_map_mut(&mut self) -> &mut dyn VoxelMap {
+    pub fn as_map_mut(&mut self) -> &mut dyn VoxelMapMut {
         match self {
             Self::Fuzzy(m) => m,
             Self::LogOdds(m) => m,

@@ -1,14 +1,14 @@
 use super::VoxelMap;
 use super::counts::VoxelCounts;
-use crate::error::{Error, Result};
-use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud};
+use crate::error::Result;
 use crate::measures::{MeasureConfig, Memberships};
 use crate::storage::{Resolution, VoxelKey};
 
 /// A read-only map whose memberships come from a function of the voxel key: ground truth from
 /// a scene model, a synthetic world for tests and benchmarks, or a view computed from another
 /// source. Planners and metrics run on it like on any map; it stores nothing, so it has no
-/// cells to list or count, and integrating into it is an error.
+/// cells to list or count, and it does not integrate observations (it is no
+/// [`VoxelMapMut`](super::VoxelMapMut)).
 ///
 /// ```
 /// use fuzzyvox::map::FunctionMap;
@@ -57,22 +57,6 @@ impl<F: Fn(VoxelKey) -> Memberships + Send + Sync> VoxelMap for FunctionMap<F> {
 
     fn memberships_at(&self, key: VoxelKey) -> Memberships {
         (self.memberships)(key)
-    }
-
-    fn integrate_cloud(
-        &mut self,
-        _: &PointCloud,
-        _: &IntegrationOptions,
-    ) -> Result<IntegrationStats> {
-        Err(Error::Incompatible("a function map is read-only".into()))
-    }
-
-    fn integrate_depth(
-        &mut self,
-        _: &DepthFrame,
-        _: &IntegrationOptions,
-    ) -> Result<IntegrationStats> {
-        Err(Error::Incompatible("a function map is read-only".into()))
     }
 
     fn counts(&self) -> VoxelCounts {

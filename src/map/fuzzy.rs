@@ -1,8 +1,8 @@
 use rayon::prelude::*;
 
-use super::VoxelMap;
 use super::config::FuzzyConfig;
 use super::counts::VoxelCounts;
+use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
 use crate::integrate::{
     DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
@@ -20,7 +20,7 @@ use crate::storage::{BlockGrid, KeyBox, Resolution, VoxelKey};
 /// of observations, and two maps of the same area [`merge`](FuzzyMap::merge) exactly.
 ///
 /// ```
-/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap};
+/// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap, VoxelMapMut};
 /// use nalgebra::Point3;
 ///
 /// let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
@@ -186,7 +186,9 @@ impl VoxelMap for FuzzyMap {
     fn memberships_at(&self, key: VoxelKey) -> Memberships {
         self.grid.cell(key).copied().unwrap_or_default()
     }
+}
 
+impl VoxelMapMut for FuzzyMap {
     fn integrate_cloud(
         &mut self,
         cloud: &PointCloud,

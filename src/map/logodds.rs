@@ -1,8 +1,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::VoxelMap;
 use super::counts::VoxelCounts;
+use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result, finite};
 use crate::integrate::{
     DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanLevels, ScanSets, scan_sets,
@@ -298,22 +298,6 @@ impl VoxelMap for LogOddsMap {
         self.log_odds_at(key).memberships()
     }
 
-    fn integrate_cloud(
-        &mut self,
-        cloud: &PointCloud,
-        options: &IntegrationOptions,
-    ) -> Result<IntegrationStats> {
-        self.integrate_selected(cloud, options, |_| true)
-    }
-
-    fn integrate_depth(
-        &mut self,
-        frame: &DepthFrame,
-        options: &IntegrationOptions,
-    ) -> Result<IntegrationStats> {
-        self.integrate_cloud(&frame.to_cloud()?, options)
-    }
-
     fn counts(&self) -> VoxelCounts {
         LogOddsMap::counts(self)
     }
@@ -329,6 +313,24 @@ impl VoxelMap for LogOddsMap {
                 .filter(|(_, c)| c.is_observed())
                 .map(|(k, c)| (k, c.memberships())),
         )
+    }
+}
+
+impl VoxelMapMut for LogOddsMap {
+    fn integrate_cloud(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        self.integrate_selected(cloud, options, |_| true)
+    }
+
+    fn integrate_depth(
+        &mut self,
+        frame: &DepthFrame,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        self.integrate_cloud(&frame.to_cloud()?, options)
     }
 }
 

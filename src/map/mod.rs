@@ -28,8 +28,12 @@ use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCl
 use crate::measures::{MeasureConfig, Measures, Memberships, VoxelClass};
 use crate::storage::{Resolution, VoxelKey};
 
-/// What every map offers: integration of the same observations, and the same measures per
-/// voxel, so that experiments can feed identical data to each map and compare them fairly.
+/// What every map answers: memberships, measures and classes per voxel, counts, memory and its
+/// observed voxels, so that planners, metrics and exporters run on any map alike: the three
+/// maps that integrate observations, and read-only ones such as
+/// [`FunctionMap`] or an OctoMap tree.
+///
+/// Maps that integrate observations also implement [`VoxelMapMut`].
 pub trait VoxelMap: Send + Sync {
     /// The voxel size.
     fn resolution(&self) -> Resolution;
@@ -39,20 +43,6 @@ pub trait VoxelMap: Send + Sync {
 
     /// A voxel's memberships (both 0 when nothing is known about it).
     fn memberships_at(&self, key: VoxelKey) -> Memberships;
-
-    /// Integrates one point cloud as one scan. On error the map is unchanged.
-    fn integrate_cloud(
-        &mut self,
-        cloud: &PointCloud,
-        options: &IntegrationOptions,
-    ) -> Result<IntegrationStats>;
-
-    /// Integrates one interval depth image as one scan. On error the map is unchanged.
-    fn integrate_depth(
-        &mut self,
-        frame: &DepthFrame,
-        options: &IntegrationOptions,
-    ) -> Result<IntegrationStats>;
 
     /// Voxel counts per class over the allocated blocks (from block summaries).
     fn counts(&self) -> VoxelCounts;
@@ -88,4 +78,24 @@ pub trait VoxelMap: Send + Sync {
     fn class_at(&self, key: VoxelKey) -> VoxelClass {
         self.measure_config().classify(self.memberships_at(key))
     }
+}
+
+/// What a map that integrates observations adds to [`VoxelMap`]: the same point clouds and
+/// interval depth images for every map, so that experiments can feed identical data to each map
+/// and compare them fairly. Read-only maps do not implement it, so writing to one does not
+/// compile.
+pub trait VoxelMapMut: VoxelMap {
+    /// Integrates one point cloud as one scan. On error the map is unchanged.
+    fn integrate_cloud(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats>;
+
+    /// Integrates one interval depth image as one scan. On error the map is unchanged.
+    fn integrate_depth(
+        &mut self,
+        frame: &DepthFrame,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats>;
 }

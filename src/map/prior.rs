@@ -23,7 +23,7 @@ impl FuzzyMap {
     /// occupied and free voxels.
     ///
     /// ```
-    /// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap};
+    /// use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap, VoxelMapMut};
     /// use nalgebra::Point3;
     ///
     /// // Yesterday's map: one wall point seen from the origin.

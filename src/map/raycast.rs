@@ -47,7 +47,7 @@ impl RayHit {
 ///
 /// let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
 /// let cloud = PointCloud::new(Point3::origin(), vec![Point3::new(2.05, 0.05, 0.05)])?;
-/// fuzzyvox::VoxelMap::integrate_cloud(&mut map, &cloud, &IntegrationOptions::default())?;
+/// fuzzyvox::VoxelMapMut::integrate_cloud(&mut map, &cloud, &IntegrationOptions::default())?;
 /// let hit = cast_ray(
 ///     &map,
 ///     &Point3::new(0.0, 0.05, 0.05),
@@ -165,12 +165,12 @@ fn chord(
 mod tests {
     use super::*;
     use crate::integrate::{IntegrationOptions, PointCloud};
-    use crate::map::{FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap};
+    use crate::map::{FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, VoxelMapMut};
 
     const OCCUPIED: &[VoxelClass] = &[VoxelClass::Occupied];
 
     /// A wall at x = 3 m seen from the origin, in a map of `res` metres.
-    fn wall_map(map: &mut dyn VoxelMap) {
+    fn wall_map(map: &mut dyn VoxelMapMut) {
         let points = (0..41)
             .flat_map(|i| (0..41).map(move |j| (i, j)))
             .map(|(i, j)| Point3::new(3.0, -1.0 + 0.05 * f64::from(i), -1.0 + 0.05 * f64::from(j)))

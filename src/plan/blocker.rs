@@ -264,6 +264,7 @@ fn class_name<S: Serializer>(class: &VoxelClass, serializer: S) -> Result<S::Ok,
 mod tests {
     use super::*;
     use crate::integrate::{IntegrationOptions, PointCloud};
+    use crate::map::VoxelMapMut;
     use crate::map::{FunctionMap, FuzzyConfig, FuzzyMap};
     use crate::measures::Memberships;
     use crate::plan::{PlanError, PlannerConfig, UnknownPolicy, plan_path};

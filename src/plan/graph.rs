@@ -47,7 +47,7 @@ const fn neighbour_table() -> [([i32; 3], f32); 26] {
 ///
 /// ```
 /// use fuzzyvox::plan::{CostField, PlannerConfig, PlanningRegion, VoxelGraph};
-/// use fuzzyvox::{FuzzyConfig, FuzzyMap, PointCloud, VoxelKey, VoxelMap};
+/// use fuzzyvox::{FuzzyConfig, FuzzyMap, PointCloud, VoxelKey, VoxelMap, VoxelMapMut};
 /// use nalgebra::Point3;
 ///
 /// // A wall 3 m ahead, scanned twice: the space before it is free.

@@ -25,7 +25,7 @@ use crate::error::{Error, FormatError, Result};
 use crate::storage::VoxelKey;
 
 use super::cursor::Cursor;
-use super::header::parse_header;
+use super::header::{decode_declared, parse_header};
 
 /// Depth of OctoMap's tree: leaves at this depth are single voxels.
 pub(super) const TREE_DEPTH: u8 = 16;
@@ -149,21 +149,9 @@ pub fn decode_bt(bytes: &[u8]) -> Result<BtMap, FormatError> {
     }
     // Every node but the root is announced by two bits of its parent's two bytes.
     let most = data.len().saturating_mul(4).saturating_add(1);
-    if header.size > most as u64 {
-        return Err(FormatError::Invalid(format!(
-            "header declares {} nodes, but {} bytes of tree data hold at most {most}",
-            header.size,
-            data.len()
-        )));
-    }
-    let declared = usize::try_from(header.size).unwrap_or(usize::MAX);
-    map.node_count = decode_tree(data, declared, &mut map.leaves)?;
-    if map.node_count != declared {
-        return Err(FormatError::Invalid(format!(
-            "header declares {declared} nodes, the tree data holds {}",
-            map.node_count
-        )));
-    }
+    map.node_count = decode_declared(header.size, data.len(), most, |declared| {
+        decode_tree(data, declared, &mut map.leaves)
+    })?;
     Ok(map)
 }
 

@@ -131,3 +131,28 @@ impl<'a> Tokens<'a> {
             .map_or(rest.len(), |i| i + 1);
     }
 }
+
+/// Checks a header's declared node count against the `most` nodes `data_len` bytes of tree data
+/// can hold (before decoding anything), runs `decode` with the declared count as its limit, and
+/// checks that it read exactly that many nodes. Returns the node count.
+pub(super) fn decode_declared(
+    declared: u64,
+    data_len: usize,
+    most: usize,
+    decode: impl FnOnce(usize) -> Result<usize, FormatError>,
+) -> Result<usize, FormatError> {
+    if declared > most as u64 {
+        return Err(FormatError::Invalid(format!(
+            "header declares {declared} nodes, but {data_len} bytes of tree data hold at most \
+             {most}"
+        )));
+    }
+    let declared = usize::try_from(declared).unwrap_or(usize::MAX);
+    let read = decode(declared)?;
+    if read != declared {
+        return Err(FormatError::Invalid(format!(
+            "header declares {declared} nodes, the tree data holds {read}"
+        )));
+    }
+    Ok(read)
+}

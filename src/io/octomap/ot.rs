@@ -19,7 +19,7 @@ use crate::storage::VoxelKey;
 
 use super::bt::{KEY_OFFSET, TREE_DEPTH};
 use super::cursor::Cursor;
-use super::header::parse_header;
+use super::header::{decode_declared, parse_header};
 use super::tree::{OcTreeMap, OctreeLeaf};
 
 /// The start of the first line of every `.ot` file.
@@ -58,22 +58,9 @@ pub(super) fn decode_ot(bytes: &[u8]) -> Result<OtTree, FormatError> {
     if header.size == 0 {
         return Ok(tree);
     }
-    let most = data.len() / NODE_BYTES;
-    if header.size > most as u64 {
-        return Err(FormatError::Invalid(format!(
-            "header declares {} nodes, but {} bytes of tree data hold at most {most}",
-            header.size,
-            data.len()
-        )));
-    }
-    let declared = usize::try_from(header.size).unwrap_or(usize::MAX);
-    tree.node_count = decode_tree(data, declared, &mut tree.leaves)?;
-    if tree.node_count != declared {
-        return Err(FormatError::Invalid(format!(
-            "header declares {declared} nodes, the tree data holds {}",
-            tree.node_count
-        )));
-    }
+    tree.node_count = decode_declared(header.size, data.len(), data.len() / NODE_BYTES, |n| {
+        decode_tree(data, n, &mut tree.leaves)
+    })?;
     Ok(tree)
 }
 

@@ -17,7 +17,6 @@ use std::path::Path;
 use super::bt::{BtMap, FILE_HEADER as BT_HEADER, KEY_OFFSET, TREE_DEPTH, cube_keys};
 use super::ot::{OT_HEADER, decode_ot};
 use crate::error::{Error, FormatError, Result};
-use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud};
 use crate::map::{LogOdds, LogOddsConfig, VoxelCounts, VoxelMap};
 use crate::measures::{MeasureConfig, Memberships};
 use crate::storage::{Resolution, VoxelKey};
@@ -88,6 +87,22 @@ impl OctreeFormat {
 /// let class = map.class_at_point(&Point3::new(0.0, 0.0, 1.0))?;
 /// assert_ne!(class, VoxelClass::Ambiguous);
 /// # Ok::<(), fuzzyvox::Error>(())
+/// ```
+///
+/// The map is read-only: it is no [`VoxelMapMut`](crate::map::VoxelMapMut), so integrating
+/// into it does not compile (start a fuzzy map from it with
+/// [`FuzzyMap::add_prior`](crate::FuzzyMap::add_prior) instead):
+///
+/// ```compile_fail
+/// use fuzzyvox::io::octomap::OcTreeMap;
+/// use fuzzyvox::{IntegrationOptions, PointCloud, VoxelMapMut};
+///
+/// fn integrate(map: &mut dyn VoxelMapMut, cloud: &PointCloud) {
+///     map.integrate_cloud(cloud, &IntegrationOptions::default()).unwrap();
+/// }
+/// let mut map = OcTreeMap::decode(b"").unwrap();
+/// let cloud = PointCloud::new(nalgebra::Point3::origin(), vec![]).unwrap();
+/// integrate(&mut map, &cloud);
 /// ```
 #[derive(Clone, Debug)]
 pub struct OcTreeMap {
@@ -429,22 +444,6 @@ impl VoxelMap for OcTreeMap {
             .unwrap_or_default()
     }
 
-    fn integrate_cloud(
-        &mut self,
-        _: &PointCloud,
-        _: &IntegrationOptions,
-    ) -> Result<IntegrationStats> {
-        Err(Error::Incompatible(read_only()))
-    }
-
-    fn integrate_depth(
-        &mut self,
-        _: &DepthFrame,
-        _: &IntegrationOptions,
-    ) -> Result<IntegrationStats> {
-        Err(Error::Incompatible(read_only()))
-    }
-
     fn counts(&self) -> VoxelCounts {
         self.counts
     }
@@ -459,10 +458,4 @@ impl VoxelMap for OcTreeMap {
             cube_keys(leaf.key, leaf.side()).map(move |k| (k, m))
         }))
     }
-}
-
-fn read_only() -> String {
-    "an OctoMap tree is read-only: build a fuzzy map with it as a prior (`--prior`) to add \
-     observations"
-        .into()
 }
