@@ -140,7 +140,9 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
         // every camera position counts as much as in a stream of pairs.
         let weight = result.reuse_weight();
         let mut depth = result.frame;
-        depth.scale_confidence(weight)?;
+        if weight < 1.0 {
+            depth.scale_confidence(weight)?;
+        }
         let t = Instant::now();
         if let Some(sensor) = folder.read_sensor_depth(position)? {
             stage.add(&depth, &sensor);

@@ -4,7 +4,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use super::mapfile::{MAGIC, MapHeader, read_header};
+use super::mapfile::{MAGIC, MapHeader};
 use super::octomap::{OcTreeMap, OctreeFormat};
 use crate::error::{Error, FormatError, Result};
 use crate::map::{AnyMap, VoxelMap};
@@ -98,10 +98,10 @@ pub fn load_map(path: &Path) -> Result<LoadedMap> {
             source,
         })?;
     match MapFormat::sniff(&start) {
-        Some(MapFormat::Native) => Ok(LoadedMap::Native {
-            header: read_header(path)?,
-            map: AnyMap::load(path)?,
-        }),
+        Some(MapFormat::Native) => {
+            let (header, map) = AnyMap::load_with_header(path)?;
+            Ok(LoadedMap::Native { header, map })
+        }
         Some(MapFormat::OctoMap(_)) => Ok(LoadedMap::OctoMap(OcTreeMap::read(path)?)),
         None => Err(Error::Format {
             path: path.to_path_buf(),

@@ -96,6 +96,17 @@ pub fn read_header(path: &Path) -> Result<MapHeader> {
         })
 }
 
+/// Reads a whole map file once and checks its header, length and checksum; returns the header
+/// and the file's bytes for the kind's decoder.
+pub(crate) fn read_checked(path: &Path) -> Result<(MapHeader, Vec<u8>)> {
+    let bytes = read_file(path)?;
+    let (header, _) = split(&bytes).map_err(|reason| Error::Format {
+        path: path.to_path_buf(),
+        reason,
+    })?;
+    Ok((header, bytes))
+}
+
 /// Serialises a whole file: header and postcard body.
 pub(crate) fn encode<T: Serialize>(
     kind: MapKind,

@@ -27,4 +27,5 @@ pub use atomic::write_atomic;
 pub use cloud_text::{parse_text_cloud, read_text_cloud};
 pub use gray::{decode_gray_image, read_gray_image};
 pub use load::{LoadedMap, MapFormat, load_map};
+pub(crate) use mapfile::read_checked;
 pub use mapfile::{MapHeader, MapKind, read_header};

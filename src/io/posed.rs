@@ -91,12 +91,6 @@ impl PosedFolder {
                 line: 0,
                 message: format!("`{number}` is not a frame number"),
             })?;
-            if frames.iter().any(|f| f.number == parsed) {
-                return Err(Error::Duplicate(format!(
-                    "frame {number}'s colour image (two files in {})",
-                    dir.display()
-                )));
-            }
             let depth = dir.join(format!("frame-{number}.depth.png"));
             frames.push(PosedFrameFiles {
                 number: parsed,
@@ -110,6 +104,18 @@ impl PosedFolder {
             ));
         }
         frames.sort_by_key(|f| f.number);
+        let twice = frames.windows(2).find_map(|pair| match pair {
+            [a, b] if a.number == b.number => Some((a, b)),
+            _ => None,
+        });
+        if let Some((a, b)) = twice {
+            return Err(Error::Duplicate(format!(
+                "frame {}'s colour image ({} and {})",
+                a.number,
+                a.color.display(),
+                b.color.display()
+            )));
+        }
         let depth_intrinsics = dir.join("camera-intrinsics.txt");
         if !depth_intrinsics.is_file() {
             return Err(Error::Io {
@@ -141,8 +147,7 @@ impl PosedFolder {
             None => {
                 let mut poses = Vec::with_capacity(frames.len());
                 for f in &frames {
-                    let stem = format!("frame-{:06}", f.number);
-                    let path = pose_path(dir, &f.color, &stem);
+                    let path = pose_path(&f.color);
                     if !path.is_file() {
                         return Err(Error::Io {
                             path,
@@ -176,15 +181,10 @@ impl PosedFolder {
     /// Frame `index` (position in [`Self::frames`]) as the depth stage reads it: the grey image,
     /// the colour camera's intrinsics and pose, and its time.
     pub fn read_frame(&self, index: usize) -> Result<Frame> {
-        let files = self.files(index)?;
+        let (files, pose) = self.files(index)?;
         let image = read_gray_image(&files.color)?;
         let intrinsics =
             read_intrinsics_txt(&self.color_intrinsics, image.width(), image.height())?;
-        let pose = self
-            .poses
-            .get(index)
-            .copied()
-            .unwrap_or_else(Isometry3::identity);
         let time = self.times.get(index).copied().unwrap_or_default();
         Frame::new(image, intrinsics, pose, time)
     }
@@ -193,39 +193,38 @@ impl PosedFolder {
     /// times `color_from_depth`), with the Kinect noise model, or `None` when the folder has no
     /// depth image for it.
     pub fn read_sensor_depth(&self, index: usize) -> Result<Option<DepthFrame>> {
-        let files = self.files(index)?;
+        let (files, color_pose) = self.files(index)?;
         let Some(path) = &files.depth else {
             return Ok(None);
         };
         let depth = read_depth_png_mm(path)?;
         let intrinsics: PinholeIntrinsics =
             read_intrinsics_txt(&self.depth_intrinsics, depth.width, depth.height)?;
-        let pose = self
-            .poses
-            .get(index)
-            .copied()
-            .unwrap_or_else(Isometry3::identity)
-            * self.depth_from_color.inverse();
+        let pose = color_pose * self.depth_from_color.inverse();
         DepthFrame::new(intrinsics, pose, kinect_interval_image(&depth)?).map(Some)
     }
 
-    fn files(&self, index: usize) -> Result<&PosedFrameFiles> {
-        self.frames.get(index).ok_or(Error::InvalidParameter {
-            name: "frame index",
-            value: index as f64,
-            expected: "an index below the folder's frame count",
-        })
+    /// Frame `index`'s files and colour pose.
+    fn files(&self, index: usize) -> Result<(&PosedFrameFiles, Isometry3<f64>)> {
+        match (self.frames.get(index), self.poses.get(index)) {
+            (Some(files), Some(pose)) => Ok((files, *pose)),
+            _ => Err(Error::InvalidParameter {
+                name: "frame index",
+                value: index as f64,
+                expected: "an index below the folder's frame count",
+            }),
+        }
     }
 }
 
-/// `frame-N.pose.txt` beside a colour file, keeping the number's own digits.
-fn pose_path(dir: &Path, color: &Path, fallback_stem: &str) -> PathBuf {
+/// `frame-N.pose.txt` beside a `frame-N.color.*` file, keeping the number's own digits.
+fn pose_path(color: &Path) -> PathBuf {
     let name = color
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or_default();
-    let stem = name.split(".color.").next().unwrap_or(fallback_stem);
-    dir.join(format!("{stem}.pose.txt"))
+    let stem = name.split(".color.").next().unwrap_or(name);
+    color.with_file_name(format!("{stem}.pose.txt"))
 }
 
 /// Parses a TUM trajectory: one `timestamp tx ty tz qx qy qz qw` line per pose

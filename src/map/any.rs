@@ -1,8 +1,8 @@
 use std::path::Path;
 
 use super::{AlphaCutMap, FuzzyMap, LogOddsMap, VoxelMap, VoxelMapMut};
-use crate::error::Result;
-use crate::io::{MapKind, read_header};
+use crate::error::{Error, Result};
+use crate::io::{MapHeader, MapKind, read_checked};
 
 /// Any of the three maps, for code that handles whichever kind a file holds.
 #[derive(Clone, Debug)]
@@ -18,12 +18,26 @@ pub enum AnyMap {
 impl AnyMap {
     /// Loads a native map file of any kind.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        Ok(match read_header(path)?.kind {
-            MapKind::Fuzzy => Self::Fuzzy(FuzzyMap::load(path)?),
-            MapKind::LogOdds => Self::LogOdds(LogOddsMap::load(path)?),
-            MapKind::AlphaCut => Self::Alpha(AlphaCutMap::load(path)?),
-        })
+        Self::load_with_header(path.as_ref()).map(|(_, map)| map)
+    }
+
+    /// Loads a native map file of any kind, reading it once, with its header.
+    pub fn load_with_header(path: &Path) -> Result<(MapHeader, Self)> {
+        let (header, bytes) = read_checked(path)?;
+        let map = match header.kind {
+            MapKind::Fuzzy => FuzzyMap::from_bytes(&bytes).map(Self::Fuzzy),
+            MapKind::LogOdds => LogOddsMap::from_bytes(&bytes).map(Self::LogOdds),
+            MapKind::AlphaCut => AlphaCutMap::from_bytes(&bytes).map(Self::Alpha),
+        };
+        // The decoders name the bytes `<memory>`; name the file instead.
+        let map = map.map_err(|error| match error {
+            Error::Format { reason, .. } => Error::Format {
+                path: path.to_path_buf(),
+                reason,
+            },
+            other => other,
+        })?;
+        Ok((header, map))
     }
 
     /// Saves the map atomically in the native format.

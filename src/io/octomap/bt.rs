@@ -31,6 +31,24 @@ use super::header::{decode_declared, parse_header};
 pub(super) const TREE_DEPTH: u8 = 16;
 /// OctoMap key of the voxel fuzzyvox calls key 0 (OctoMap keys are `floor(p / res) + 2^15`).
 pub(super) const KEY_OFFSET: i32 = 1 << 15;
+/// The OctoMap key of the lowest corner of child `child` (x in bit 0, y in 1, z in 2) of the node
+/// at `depth` whose lowest corner is `parent`.
+pub(super) fn child_corner(parent: [u32; 3], depth: u8, child: u32) -> [u32; 3] {
+    let half = 1u32 << (TREE_DEPTH - 1 - depth.min(TREE_DEPTH - 1));
+    let offset = |axis: u32| ((child >> axis) & 1) * half;
+    [
+        parent[0] + offset(0),
+        parent[1] + offset(1),
+        parent[2] + offset(2),
+    ]
+}
+
+/// The fuzzyvox key of an OctoMap key (corners are below 2^16, so the conversion is exact).
+pub(super) fn voxel_key(octomap: [u32; 3]) -> VoxelKey {
+    let ours = |k: u32| k as i32 - KEY_OFFSET;
+    VoxelKey::new(ours(octomap[0]), ours(octomap[1]), ours(octomap[2]))
+}
+
 /// The start of the first line of every `.bt` file.
 pub(super) const FILE_HEADER: &str = "# Octomap OcTree binary file";
 
@@ -206,12 +224,7 @@ fn decode_tree(
             )));
         }
         let depth = frame.depth + 1;
-        let half = 1u32 << (TREE_DEPTH - depth);
-        let corner = [
-            frame.corner[0] + (i & 1) * half,
-            frame.corner[1] + ((i >> 1) & 1) * half,
-            frame.corner[2] + ((i >> 2) & 1) * half,
-        ];
+        let corner = child_corner(frame.corner, frame.depth, i);
         match code {
             1 => leaves.push(leaf(corner, depth, false)),
             2 => leaves.push(leaf(corner, depth, true)),
@@ -251,10 +264,8 @@ fn children(c: &mut Cursor<'_>) -> Result<u16, FormatError> {
 }
 
 fn leaf(corner: [u32; 3], depth: u8, occupied: bool) -> BtLeaf {
-    // Corners are below 2^16, so these conversions are exact.
-    let ours = |k: u32| k as i32 - KEY_OFFSET;
     BtLeaf {
-        key: VoxelKey::new(ours(corner[0]), ours(corner[1]), ours(corner[2])),
+        key: voxel_key(corner),
         depth,
         occupied,
     }

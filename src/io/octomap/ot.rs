@@ -15,9 +15,8 @@ use std::path::Path;
 
 use crate::error::{FormatError, Result};
 use crate::io::write_atomic;
-use crate::storage::VoxelKey;
 
-use super::bt::{KEY_OFFSET, TREE_DEPTH};
+use super::bt::{TREE_DEPTH, child_corner, voxel_key};
 use super::cursor::Cursor;
 use super::header::{decode_declared, parse_header};
 use super::tree::{OcTreeMap, OctreeLeaf};
@@ -110,12 +109,7 @@ fn decode_tree(
             )));
         }
         let depth = frame.depth + 1;
-        let half = 1u32 << (TREE_DEPTH - depth);
-        let corner = [
-            frame.corner[0] + (i & 1) * half,
-            frame.corner[1] + ((i >> 1) & 1) * half,
-            frame.corner[2] + ((i >> 2) & 1) * half,
-        ];
+        let corner = child_corner(frame.corner, frame.depth, i);
         let at = c.position();
         let (value, children) = node(&mut c)?;
         if children == 0 {
@@ -153,9 +147,8 @@ fn leaf(corner: [u32; 3], depth: u8, log_odds: f32) -> Result<OctreeLeaf, Format
             "a leaf at depth {depth} has log-odds {log_odds}"
         )));
     }
-    let ours = |k: u32| k as i32 - KEY_OFFSET;
     Ok(OctreeLeaf {
-        key: VoxelKey::new(ours(corner[0]), ours(corner[1]), ours(corner[2])),
+        key: voxel_key(corner),
         depth,
         log_odds,
     })

@@ -14,7 +14,9 @@
 
 use std::path::Path;
 
-use super::bt::{BtMap, FILE_HEADER as BT_HEADER, KEY_OFFSET, TREE_DEPTH, cube_keys};
+use super::bt::{
+    BtMap, FILE_HEADER as BT_HEADER, KEY_OFFSET, TREE_DEPTH, child_corner, cube_keys, voxel_key,
+};
 use super::ot::{OT_HEADER, decode_ot};
 use crate::error::{Error, FormatError, Result};
 use crate::map::{LogOdds, LogOddsConfig, VoxelCounts, VoxelMap};
@@ -265,27 +267,20 @@ impl OcTreeMap {
                 let mask = self.masks.get(node).copied().unwrap_or_default();
                 let data = self.data.get(node).copied().unwrap_or_default();
                 if mask == 0 {
-                    let ours = |k: u32| k as i32 - KEY_OFFSET;
                     return Some(OctreeLeaf {
-                        key: VoxelKey::new(ours(corner[0]), ours(corner[1]), ours(corner[2])),
+                        key: voxel_key(corner),
                         depth,
                         log_odds: f32::from_bits(data),
                     });
                 }
                 // Push the children last first, so that they pop in child order.
-                let half = 1u32 << (TREE_DEPTH - 1 - depth.min(TREE_DEPTH - 1));
                 let mut slot = data as usize + mask.count_ones() as usize;
                 for child in (0..8u32).rev() {
                     if mask & (1 << child) == 0 {
                         continue;
                     }
                     slot -= 1;
-                    let offset = |axis: u32| ((child >> axis) & 1) * half;
-                    let at = [
-                        corner[0] + offset(0),
-                        corner[1] + offset(1),
-                        corner[2] + offset(2),
-                    ];
+                    let at = child_corner(corner, depth, child);
                     stack.push((slot, depth + 1, at));
                 }
             }
