@@ -11,8 +11,8 @@ use fuzzyvox::VoxelMapMut;
 use std::path::PathBuf;
 
 use fuzzyvox::depth::{DepthParams, GrayImage, StereoGeometry, depth_from_rectified};
+use fuzzyvox::figure::{View, ViewColor, write_view_png};
 use fuzzyvox::io::middlebury::read_middlebury;
-use fuzzyvox::io::views::{View, ViewColor, write_view_png};
 use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PinholeIntrinsics, VoxelMap};
 use nalgebra::Isometry3;
 

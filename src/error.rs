@@ -122,6 +122,9 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A figure or chart could not be drawn (the message says why).
+    #[error("could not draw the figure: {0}")]
+    Figure(String),
 }
 
 /// Why a map file could not be read.

@@ -49,6 +49,7 @@
 pub mod depth;
 mod error;
 pub mod eval;
+pub mod figure;
 pub mod geometry;
 pub mod integrate;
 pub mod io;
@@ -58,6 +59,7 @@ pub mod ops;
 pub mod plan;
 pub mod sim;
 pub mod storage;
+pub mod view;
 
 pub use error::{Error, FormatError, Result};
 pub use geometry::{PinholeIntrinsics, pose_from_matrix, validate_pose};

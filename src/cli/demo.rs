@@ -5,9 +5,10 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use fuzzyvox::VoxelClass;
-use fuzzyvox::eval::{file_stem, write_experiment};
+use fuzzyvox::eval::{file_stem, report_html, write_experiment};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::io::ply::{PlyEncoding, write_ply};
+use fuzzyvox::ops::Family;
 use fuzzyvox::plan::UnknownPolicy;
 use fuzzyvox::sim::scenario;
 
@@ -63,14 +64,15 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
                 scenario.pairs.len()
             );
         }
-        let mut config = experiment_config(
-            &scenario,
-            0.2,
-            Vec::new(),
-            1,
-            flights,
-            UnknownPolicy::Forbid,
-        );
+        // The wall also compares aggregation operators: the maximum (idempotent, what a
+        // possibilistic map would use) and the bounded sum beside the default probabilistic sum.
+        let operators = if scenario.name == "wall" {
+            vec![Family::Minimum, Family::Lukasiewicz]
+        } else {
+            Vec::new()
+        };
+        let mut config =
+            experiment_config(&scenario, 0.2, operators, 1, flights, UnknownPolicy::Forbid);
         config.evidence = args.evidence.model();
         let output = run_with_bar(&scenario, &config, args.json)?;
         let (section, _) = write_experiment(&args.out, &scenario, &output)?;
@@ -94,11 +96,17 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let _ = writeln!(
         report,
         "Each map is also saved as `.fvx` (open with `fuzzyvox info`, plan with `fuzzyvox \
-         plan`), `.bt` (OctoMap's tools and octovis) and `.ply` (occupied and ambiguous voxel \
-         centres with their measures, for point-cloud viewers).\n\nTotal time {:.1} s.",
+         plan`, view with `fuzzyvox view`), `.html` (its 3D viewer page, with the camera's \
+         trajectory and the planned flights), `.bt` (OctoMap's tools and octovis) and `.ply` \
+         (occupied and ambiguous voxel centres with their measures, for point-cloud \
+         viewers).\n\nTotal time {:.1} s.",
         started.elapsed().as_secs_f64()
     );
     fuzzyvox::io::write_atomic(&args.out.join("report.md"), report.as_bytes())?;
+    fuzzyvox::io::write_atomic(
+        &args.out.join("report.html"),
+        report_html("fuzzyvox demo", &report).as_bytes(),
+    )?;
     fuzzyvox::io::write_atomic(
         &args.out.join("metrics.json"),
         serde_json::to_string_pretty(&all)?.as_bytes(),
@@ -110,7 +118,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         return super::print_json(&serde_json::Value::Object(all));
     }
     println!(
-        "wrote {} (report.md, metrics.json, maps and figures) in {seconds:.1} s",
+        "wrote {} (report.html and report.md, metrics.json, maps, figures, charts and 3D viewer \
+         pages) in {seconds:.1} s",
         args.out.display(),
     );
     Ok(())

@@ -3,10 +3,10 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use fuzzyvox::VoxelClass;
+use fuzzyvox::figure::{View, ViewColor, ViewSpec, save_png, view_figure};
 use fuzzyvox::io::load_map;
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::io::ply::{PlyEncoding, write_ply};
-use fuzzyvox::io::views::{View, ViewColor, write_view_png};
 use serde_json::{Value, json};
 use tracing::info;
 
@@ -24,9 +24,11 @@ use super::progress;
 /// 3 unknown) and a class colour; binary little-endian unless `--ascii`.
 ///
 /// `--png` draws the map from the top (x right, y up), from the side (x right, z up) or as the
-/// horizontal slice at `--height`, one pixel per voxel times `--scale`, coloured by class or by
-/// one measure. Projections show per column the most critical class, the largest membership or
-/// ambiguity, or the smallest safety.
+/// horizontal slice at `--height`, coloured by class, by one measure (viridis, 0 to 1) or by the
+/// height of the highest occupied voxel, as a figure: a title, axes in metres, a scale bar and a
+/// legend; the plot is at least 800 pixels on its long side and at least `--scale` pixels per
+/// voxel. Projections show per column the most critical class, the largest membership or
+/// ambiguity, or the smallest safety. Unobserved space is light grey.
 ///
 /// Several outputs can be written in one call.
 #[derive(Args)]
@@ -65,7 +67,7 @@ pub struct ExportArgs {
     /// What colours the PNG.
     #[arg(long, value_enum, default_value_t = ColorArg::Class, requires = "png")]
     color: ColorArg,
-    /// Pixels per voxel in the PNG (1 to 16).
+    /// Pixels per voxel in the PNG at least (1 to 16; more when needed to reach 800 pixels).
     #[arg(long, default_value_t = 1, requires = "png")]
     scale: u32,
     /// Print one JSON object instead of text.
@@ -95,6 +97,7 @@ enum ColorArg {
     Free,
     Ambiguity,
     Safety,
+    Height,
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
@@ -169,9 +172,29 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
             ColorArg::Free => ViewColor::Free,
             ColorArg::Ambiguity => ViewColor::Ambiguity,
             ColorArg::Safety => ViewColor::Safety,
+            ColorArg::Height => ViewColor::Height,
         };
-        let (width, height) = write_view_png(map.as_map(), view, color, args.scale, png)
-            .with_context(|| format!("writing {}", png.display()))?;
+        let title = format!(
+            "{}: {} view by {}, {} m voxels",
+            args.map.file_name().unwrap_or_default().to_string_lossy(),
+            match view {
+                View::Top => "top".to_string(),
+                View::Side => "side".to_string(),
+                View::Slice { z } => format!("slice at z = {z} m"),
+            },
+            color.name(),
+            map.as_map().resolution().size()
+        );
+        let figure = view_figure(
+            map.as_map(),
+            &ViewSpec::new(view, color),
+            &title,
+            Vec::new(),
+            args.scale,
+        )
+        .with_context(|| format!("drawing {}", png.display()))?;
+        save_png(&figure, png).with_context(|| format!("writing {}", png.display()))?;
+        let (width, height) = figure.dimensions();
         info!("wrote {}", png.display());
         let view_name = match view {
             View::Top => "top",

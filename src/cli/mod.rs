@@ -15,6 +15,7 @@ pub mod progress;
 mod rgbd;
 mod simulate;
 mod stereo;
+mod view;
 
 use std::process::ExitCode;
 
@@ -32,6 +33,7 @@ use clap::{Parser, Subcommand};
         fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
         fuzzyvox info scan.fvx\n  \
         fuzzyvox export scan.fvx --png top.png --ply scan.ply --bt scan.bt\n  \
+        fuzzyvox view scan.fvx --out scan.html\n  \
         fuzzyvox plan --map scan.fvx --from 3,0,0.5 --to 7,-11,0.5\n  \
         fuzzyvox rgbd --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.02\n  \
         fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04\n  \
@@ -58,6 +60,7 @@ enum Command {
     Simulate(simulate::SimulateArgs),
     Rgbd(rgbd::RgbdArgs),
     Mono(mono::MonoArgs),
+    View(view::ViewArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -75,6 +78,7 @@ pub fn run() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Rgbd(args) => rgbd::run(args),
         Command::Mono(args) => mono::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,6 +5,7 @@ use clap::{Args, ValueEnum};
 use fuzzyvox::depth::{
     Accuracy, DepthParams, GrayImage, IntervalMethod, depth_from_rectified, evaluate,
 };
+use fuzzyvox::figure::{ImagePanel, image_figure, save_png};
 use fuzzyvox::io::middlebury::read_calib;
 use fuzzyvox::io::pfm::{read_pfm, write_pfm};
 use fuzzyvox::io::read_gray_image;
@@ -206,40 +207,23 @@ fn write_outputs(
     for (name, plane) in planes {
         write_pfm(&dir.join(format!("{name}.pfm")), w, h, plane)?;
         let png = dir.join(format!("{name}.png"));
-        colour_png(
-            w,
-            h,
-            plane,
-            name == "depth" || name == "near" || name == "far",
-        )
-        .save(&png)
-        .with_context(|| format!("writing {}", png.display()))?;
+        let (unit, range) = match name {
+            "confidence" => ("confidence", [0.0, 1.0]),
+            "disparity" => ("px", ImagePanel::robust_range(plane)),
+            _ => ("m", ImagePanel::robust_range(image.depth())),
+        };
+        let panel = ImagePanel {
+            title: format!("{name} ({w} × {h} pixels)"),
+            values: plane,
+            width: w,
+            height: h,
+            unit: unit.into(),
+            range,
+            grey: false,
+        };
+        let figure = image_figure(&format!("fuzzyvox stereo: {name}"), &[panel], 1)
+            .with_context(|| format!("drawing {}", png.display()))?;
+        save_png(&figure, &png).with_context(|| format!("writing {}", png.display()))?;
     }
     Ok(())
-}
-
-/// A colour-mapped image of a plane: blue (low) to red (high) over its finite range, reversed
-/// for depths so that near is warm; black where there is no value.
-fn colour_png(width: u32, height: u32, plane: &[f32], reverse: bool) -> image::RgbImage {
-    let finite = plane.iter().copied().filter(|v| v.is_finite());
-    let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
-        (lo.min(v), hi.max(v))
-    });
-    let span = (hi - lo).max(f32::EPSILON);
-    let mut bytes = Vec::with_capacity(plane.len() * 3);
-    for &v in plane {
-        if !v.is_finite() {
-            bytes.extend_from_slice(&[0, 0, 0]);
-            continue;
-        }
-        let mut t = ((v - lo) / span).clamp(0.0, 1.0);
-        if reverse {
-            t = 1.0 - t;
-        }
-        // Jet: blue → cyan → yellow → red.
-        let channel =
-            |centre: f32| ((1.5 - (4.0 * t - centre).abs()).clamp(0.0, 1.0) * 255.0) as u8;
-        bytes.extend_from_slice(&[channel(3.0), channel(2.0), channel(1.0)]);
-    }
-    image::RgbImage::from_raw(width, height, bytes).unwrap_or_default()
 }

@@ -9,7 +9,7 @@ use nalgebra::Point3;
 use serde::Serialize;
 
 use super::rgbd::median;
-use crate::integrate::DepthFrame;
+use crate::integrate::{DepthFrame, IntervalDepthImage};
 
 /// One compared pixel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,6 +47,19 @@ pub struct DepthStageSummary {
     pub interval_coverage_top50: f64,
 }
 
+/// One group of [`DepthStageErrors::by_confidence`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ConfidenceBin {
+    /// Mean confidence of the group.
+    pub confidence: f64,
+    /// Pixels in it.
+    pub pixels: usize,
+    /// Median of `|P0 - z| / z`.
+    pub median_rel_error: f64,
+    /// Fraction whose true depth lies in `[P-, P+]`.
+    pub interval_coverage: f64,
+}
+
 impl DepthStageErrors {
     /// Compares one depth-stage image with a sensor's depth (`sensor`'s `P0` is its reading;
     /// pixels without one are skipped). Where several readings land on one pixel of the
@@ -77,10 +90,15 @@ impl DepthStageErrors {
                 *slot = slot.min(p.z as f32);
             }
         }
-        let image = estimate.image();
-        for (i, &truth) in nearest.iter().enumerate() {
+        self.add_aligned(estimate.image(), &nearest);
+    }
+
+    /// Compares a depth-stage image with true depths already in its camera, pixel for pixel
+    /// (`truth` row-major like the image; non-finite or non-positive entries are skipped).
+    pub fn add_aligned(&mut self, image: &IntervalDepthImage, truth: &[f32]) {
+        for (i, &truth) in truth.iter().enumerate() {
             let depth = image.depth().get(i).copied().unwrap_or(f32::NAN);
-            if !(truth.is_finite() && depth.is_finite() && depth > 0.0) {
+            if !(truth.is_finite() && truth > 0.0 && depth.is_finite() && depth > 0.0) {
                 continue;
             }
             let near = image.near().get(i).copied().unwrap_or(depth);
@@ -93,6 +111,32 @@ impl DepthStageErrors {
             });
         }
         self.images += 1;
+    }
+
+    /// Accuracy against confidence: the compared pixels sorted by confidence and cut into
+    /// `bins` groups of equal size (fewer when there are fewer pixels), each with its mean
+    /// confidence, median relative error and interval coverage. A confidence that ranks depth
+    /// well gives errors that fall as confidence rises.
+    pub fn by_confidence(&self, bins: usize) -> Vec<ConfidenceBin> {
+        let mut sorted = self.compared.clone();
+        sorted.sort_by(|a, b| a.confidence.total_cmp(&b.confidence));
+        let bins = bins.clamp(1, sorted.len().max(1));
+        (0..bins)
+            .filter_map(|b| {
+                let part = &sorted[b * sorted.len() / bins..(b + 1) * sorted.len() / bins];
+                if part.is_empty() {
+                    return None;
+                }
+                let (error, coverage) = figures(part);
+                Some(ConfidenceBin {
+                    confidence: part.iter().map(|c| f64::from(c.confidence)).sum::<f64>()
+                        / part.len() as f64,
+                    pixels: part.len(),
+                    median_rel_error: error,
+                    interval_coverage: coverage,
+                })
+            })
+            .collect()
     }
 
     /// The summary so far (medians NaN when nothing was compared).
@@ -136,7 +180,6 @@ fn figures(compared: &[Comparison]) -> (f64, f64) {
 mod tests {
     use super::*;
     use crate::geometry::PinholeIntrinsics;
-    use crate::integrate::IntervalDepthImage;
     use nalgebra::{Isometry3, Translation3};
 
     fn frame(depth: f32, near: f32, far: f32, confidence: f32, x: f64) -> DepthFrame {

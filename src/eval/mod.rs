@@ -12,6 +12,7 @@
 //! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
 //! ray-casting them into held-out frames.
 
+mod charts;
 mod depth_stage;
 mod experiment;
 mod figures;
@@ -21,17 +22,18 @@ mod report;
 mod rgbd;
 mod truth;
 
-pub use depth_stage::{DepthStageErrors, DepthStageSummary};
+pub use charts::{depth_confidence_chart, maps_chart, operators_chart};
+pub use depth_stage::{ConfidenceBin, DepthStageErrors, DepthStageSummary};
 pub use experiment::{
     DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport, run_experiment,
     run_experiment_with_progress,
 };
-pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_image, top_down_png};
+pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
 pub use flights::{
     FailureCounts, FlightConfig, FlightFailure, FlightOutcome, FlightQuery, FlightSummary,
     flight_queries, fly, summarize,
 };
 pub use metrics::{MapMetrics, evaluate};
-pub use report::{file_stem, markdown, write_experiment};
+pub use report::{file_stem, markdown, report_html, write_experiment};
 pub use rgbd::{DepthAgreement, DepthCheckConfig, DepthErrors, HoldoutSplit};
 pub use truth::{GroundTruth, gold_standard, meets_geometry};

@@ -4,11 +4,16 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::charts::{depth_confidence_chart, maps_chart, operators_chart};
 use super::experiment::{ExperimentOutput, ExperimentReport};
 use super::figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
 use super::metrics::MapMetrics;
 use crate::error::Result;
 use crate::sim::scenario::Scenario;
+use crate::view::{PagePath, PathKind, ViewerOptions, write_viewer_page};
+
+/// Free (and unknown) voxels written to each map's viewer page at most.
+const PAGE_MAX_FREE: usize = 150_000;
 
 /// File-name form of a map name (`fuzzy:dombi:2` → `fuzzy_dombi_2`).
 pub fn file_stem(name: &str) -> String {
@@ -46,10 +51,23 @@ pub fn write_experiment(
         map.save(&native)?;
         files.push(native);
         let occupied = dir.join(format!("{stem}.png"));
-        top_down_png(map.as_map(), &view, false, &occupied)?;
+        let title = |what: &str| format!("{name} scenario, {map_name} map: {what}");
+        top_down_png(
+            map.as_map(),
+            &view,
+            false,
+            &title("occupied voxels by height"),
+            &occupied,
+        )?;
         files.push(occupied);
         let free = dir.join(format!("{stem}-free.png"));
-        top_down_png(map.as_map(), &view, true, &free)?;
+        top_down_png(
+            map.as_map(),
+            &view,
+            true,
+            &title("occupied by height, free space"),
+            &free,
+        )?;
         files.push(free);
         if let Some((_, outcomes)) = output.flights.iter().find(|(n, _)| n == map_name) {
             let paths: Vec<_> = outcomes
@@ -57,21 +75,94 @@ pub fn write_experiment(
                 .filter_map(|o| Some((o.waypoints.as_deref()?, o.collides)))
                 .collect();
             let flights = dir.join(format!("{stem}-flights.png"));
-            flights_png(map.as_map(), &view, &paths, &flights)?;
+            flights_png(
+                map.as_map(),
+                &view,
+                &paths,
+                &title("planned flights (red: collides)"),
+                &flights,
+            )?;
             files.push(flights);
+        }
+    }
+    let trajectory = PagePath {
+        name: "camera".into(),
+        kind: PathKind::Trajectory,
+        ok: true,
+        points: scenario
+            .pairs
+            .iter()
+            .map(|(pose, _)| {
+                let t = pose.translation.vector;
+                [t.x, t.y, t.z]
+            })
+            .collect(),
+    };
+    for (map_name, map) in &output.maps {
+        let stem = format!("{name}-{}", file_stem(map_name));
+        let mut paths = vec![trajectory.clone()];
+        if let Some((_, outcomes)) = output.flights.iter().find(|(n, _)| n == map_name) {
+            paths.extend(outcomes.iter().enumerate().filter_map(|(i, o)| {
+                Some(PagePath {
+                    name: format!("flight {}", i + 1),
+                    kind: PathKind::Flight,
+                    ok: !o.collides,
+                    points: o
+                        .waypoints
+                        .as_ref()?
+                        .iter()
+                        .map(|p| [p.x, p.y, p.z])
+                        .collect(),
+                })
+            }));
+        }
+        let json = dir.join(format!("{stem}-paths.json"));
+        let text = serde_json::to_string(&serde_json::json!({ "paths": paths })).map_err(|e| {
+            crate::error::Error::Io {
+                path: json.clone(),
+                source: std::io::Error::other(e),
+            }
+        })?;
+        crate::io::write_atomic(&json, text.as_bytes())?;
+        files.push(json);
+        let mut options = ViewerOptions::new(
+            format!("{name} scenario, {map_name} map"),
+            map.kind().name(),
+        );
+        options.max_free = PAGE_MAX_FREE;
+        options.paths = paths;
+        let page = dir.join(format!("{stem}.html"));
+        write_viewer_page(map.as_map(), &options, &page)?;
+        files.push(page);
+    }
+    let charts = [
+        ("maps", Some(maps_chart(&output.report))),
+        ("operators", operators_chart(&output.report)),
+        (
+            "depth-confidence",
+            depth_confidence_chart(name, &output.samples),
+        ),
+    ];
+    let mut written = Vec::new();
+    for (what, chart) in charts {
+        if let Some(chart) = chart {
+            files.extend(chart.save(&dir.join(format!("{name}-{what}")))?);
+            written.push(what);
         }
     }
     for sample in &output.samples {
         let panels = dir.join(format!("{name}-pair{}.png", sample.pair));
-        depth_panels_png(sample, &panels)?;
+        let title = format!("{name} scenario, pair {}: the depth stage", sample.pair);
+        depth_panels_png(sample, &title, &panels)?;
         files.push(panels);
     }
-    Ok((markdown(scenario, output), files))
+    Ok((markdown(scenario, output, &written), files))
 }
 
 /// The Markdown section of one experiment: what was flown, the metrics (and after each phase),
-/// the flights, and the figures written by [`write_experiment`].
-pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
+/// the flights, the figures and viewer pages written by [`write_experiment`], and the charts
+/// named in `charts` (`maps`, `operators`, `depth-confidence`).
+pub fn markdown(scenario: &Scenario, output: &ExperimentOutput, charts: &[&str]) -> String {
     let report = &output.report;
     let name = scenario.name;
     let mut md = String::new();
@@ -163,10 +254,22 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
                 .join(" | ")
         );
     };
+    for chart in charts {
+        let _ = writeln!(md, "![{name} {chart} chart]({name}-{chart}.svg)\n");
+    }
+    let _ = writeln!(
+        md,
+        "3D views (open in a browser; drag to orbit, wheel to zoom, hover to read a voxel): {}\n",
+        names
+            .iter()
+            .map(|n| format!("[{n}]({name}-{}.html)", file_stem(n)))
+            .collect::<Vec<_>>()
+            .join(" · ")
+    );
     let _ = writeln!(
         md,
         "Top-down views: occupied voxel columns coloured by the height of their highest occupied \
-         voxel (blue low, yellow high).\n"
+         voxel (viridis: purple low, yellow high); unknown space light grey.\n"
     );
     header(&mut md);
     row(&mut md, "");
@@ -176,7 +279,7 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
     if !output.flights.is_empty() {
         let _ = writeln!(
             md,
-            "Planned flights over each map (black: clear of the true geometry, red: collides):\n"
+            "Planned flights over each map (blue: clear of the true geometry, red: collides):\n"
         );
         header(&mut md);
         row(&mut md, "-flights");
@@ -185,8 +288,8 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput) -> String {
         let _ = writeln!(
             md,
             "Depth stage, per kept pair: top row the image, the true depth, the error |P0 - \
-             truth| (0 to 2 m) and the confidence (black 0, white 1); bottom row P-, P0, P+ and \
-             the interval width (0 to 10 m). Black: no value.\n"
+             truth| (0 to 2 m) and the confidence (0 to 1); bottom row P-, P0, P+ and the \
+             interval width (0 to 10 m), each with its colour bar. Black: no value.\n"
         );
         for sample in &output.samples {
             let _ = writeln!(
@@ -227,3 +330,33 @@ fn table(md: &mut String, report: &ExperimentReport, phase: Option<&str>) {
     }
     let _ = writeln!(md);
 }
+
+/// The report as one HTML page (`report.html` beside `report.md`): the same Markdown rendered,
+/// with its tables, figures, charts and links to the viewer pages, styled to read well. The
+/// page needs nothing but the files beside it.
+pub fn report_html(title: &str, markdown: &str) -> String {
+    use pulldown_cmark::{Options, Parser, html};
+    let mut body = String::new();
+    html::push_html(&mut body, Parser::new_ext(markdown, Options::ENABLE_TABLES));
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <title>{}</title>\n<style>{REPORT_CSS}</style>\n</head>\n<body>\n<main>\n{body}</main>\n\
+         </body>\n</html>\n",
+        crate::view::escape_html(title)
+    )
+}
+
+const REPORT_CSS: &str = "\
+body { margin: 0; background: #fafaf7; color: #222; \
+  font: 15px/1.5 system-ui, -apple-system, 'Segoe UI', sans-serif; }
+main { max-width: 1200px; margin: 0 auto; padding: 24px; }
+h1, h2 { font-weight: 600; } h2 { margin-top: 2.2em; border-bottom: 1px solid #ddd; }
+table { border-collapse: collapse; margin: 1em 0; font-variant-numeric: tabular-nums; }
+th, td { border: 1px solid #ddd; padding: 4px 8px; text-align: right; vertical-align: top; }
+th:first-child, td:first-child { text-align: left; }
+td img { max-width: 380px; }
+img { max-width: 100%; height: auto; }
+code { background: #eee; padding: 0 3px; border-radius: 3px; }
+a { color: #0a58ca; }
+";

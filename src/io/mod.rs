@@ -21,7 +21,6 @@ pub mod posed;
 pub mod rgbd;
 pub mod rgbd_write;
 mod stored_blocks;
-pub mod views;
 
 pub use atomic::write_atomic;
 pub use cloud_text::{parse_text_cloud, read_text_cloud};
