@@ -156,15 +156,14 @@ fn export_draws_top_side_and_slice_views() {
         // Something other than background was drawn.
         assert!(image.pixels().any(|p| p.0 != [255, 255, 255]), "{name}");
     }
-    // The observed region spans x in [0, 3.1) m: 31 voxel columns in every view.
-    assert_eq!(sizes[0].0, 31);
-    assert_eq!(sizes[1].0, 31);
-    assert_eq!(sizes[2].0, 31);
-    assert_eq!(sizes[3], (93, 3 * sizes[0].1));
-    // Top view by class: the wall's column (x = 3.0 to 3.1 m, the last one) is occupied.
+    // Every view is a figure at least 800 pixels wide (title, axes, scale bar, legend).
+    for (w, h) in &sizes {
+        assert!(*w >= 800 && *h > 0, "{w} x {h}");
+    }
+    assert!(sizes[3].0 >= sizes[0].0);
+    // Top view by class: the wall (occupied, class colour 40, 40, 40) is drawn.
     let top = image::open(png("top.png")).unwrap().to_rgb8();
-    let wall_column: Vec<[u8; 3]> = (0..top.height()).map(|y| top.get_pixel(30, y).0).collect();
-    assert!(wall_column.contains(&[40, 40, 40]), "{wall_column:?}");
+    assert!(top.pixels().filter(|p| p.0 == [40, 40, 40]).count() > 100);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
