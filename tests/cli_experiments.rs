@@ -4,6 +4,7 @@ mod common;
 
 use std::path::PathBuf;
 
+use common::browser::Browser;
 use common::{fuzzyvox, json};
 
 fn scratch(name: &str) -> PathBuf {
@@ -216,11 +217,43 @@ fn demo_writes_the_report_maps_and_figures() {
             }
         }
     }
-    // Every figure the report links exists.
+    // Every figure, chart and viewer page the report links exists.
     for link in report.split("](").skip(1) {
         let name = &link[..link.find(')').unwrap()];
-        if name.ends_with(".png") {
+        if [".png", ".svg", ".html"]
+            .iter()
+            .any(|ext| name.ends_with(ext))
+        {
             assert!(out.join(name).is_file(), "report links a missing {name}");
+        }
+    }
+    // The wall scenario also compares aggregation operators.
+    for (scenario, charts) in [
+        ("wall", &["maps", "operators", "depth-confidence"][..]),
+        ("random", &["maps", "depth-confidence"][..]),
+    ] {
+        for chart in charts {
+            for ext in ["svg", "png"] {
+                let file = out.join(format!("{scenario}-{chart}.{ext}"));
+                assert!(file.is_file(), "missing {}", file.display());
+            }
+        }
+    }
+    // The report and the fuzzy map's viewer page open in a browser without console errors,
+    // and the page shows the map.
+    if let Some(browser) = Browser::find("demo_writes_the_report_maps_and_figures (browser)") {
+        let report_html = out.join("report.html");
+        let run = browser.dump_dom(&report_html, "");
+        assert!(run.console_errors().is_empty(), "{:#?}", run.console);
+        assert!(run.dom.contains("<img"), "report.html shows no figures");
+        for scenario in ["wall", "random"] {
+            let page = out.join(format!("{scenario}-fuzzy.html"));
+            let shot = out.join(format!("{scenario}-fuzzy-shot.png"));
+            let colors = browser.check_viewer_page(&page, "", &shot);
+            assert!(
+                colors >= 20,
+                "{scenario}: the screenshot has only {colors} colours"
+            );
         }
     }
     std::fs::remove_dir_all(&out).unwrap();

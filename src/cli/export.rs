@@ -10,6 +10,7 @@ use fuzzyvox::io::ply::{PlyEncoding, write_ply};
 use serde_json::{Value, json};
 use tracing::info;
 
+use super::maps::ColorArg;
 use super::progress;
 
 /// Export a saved map to other tools' formats: OctoMap `.bt`, PLY points, PNG views.
@@ -90,16 +91,6 @@ enum ViewArg {
     Slice,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum ColorArg {
-    Class,
-    Occupied,
-    Free,
-    Ambiguity,
-    Safety,
-    Height,
-}
-
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     let view = match (args.view, args.height) {
         (ViewArg::Slice, Some(z)) => View::Slice { z },
@@ -166,14 +157,7 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
     }
     if let Some(png) = &args.png {
         spinner.set_message("drawing the PNG view");
-        let color = match args.color {
-            ColorArg::Class => ViewColor::Class,
-            ColorArg::Occupied => ViewColor::Occupied,
-            ColorArg::Free => ViewColor::Free,
-            ColorArg::Ambiguity => ViewColor::Ambiguity,
-            ColorArg::Safety => ViewColor::Safety,
-            ColorArg::Height => ViewColor::Height,
-        };
+        let color = ViewColor::from(args.color);
         let title = format!(
             "{}: {} view by {}, {} m voxels",
             args.map.file_name().unwrap_or_default().to_string_lossy(),

@@ -46,6 +46,36 @@ impl Evidence {
 
 /// A new, empty map of `model` at `resolution` metres; `operator` and `evidence` apply to the
 /// fuzzy model and `cuts` to the alpha model.
+/// What colours a map's voxels in a PNG view or a viewer page (`--color`).
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ColorArg {
+    /// The class colour (occupied, free, ambiguous, unknown).
+    Class,
+    /// Height, by viridis.
+    Height,
+    /// The occupied membership, by viridis.
+    Occupied,
+    /// The free membership, by viridis.
+    Free,
+    /// Ambiguity, by viridis.
+    Ambiguity,
+    /// Safety, by viridis.
+    Safety,
+}
+
+impl From<ColorArg> for fuzzyvox::figure::ViewColor {
+    fn from(color: ColorArg) -> Self {
+        match color {
+            ColorArg::Class => Self::Class,
+            ColorArg::Height => Self::Height,
+            ColorArg::Occupied => Self::Occupied,
+            ColorArg::Free => Self::Free,
+            ColorArg::Ambiguity => Self::Ambiguity,
+            ColorArg::Safety => Self::Safety,
+        }
+    }
+}
+
 pub fn new_map(
     model: Model,
     resolution: f64,

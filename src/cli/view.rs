@@ -1,12 +1,13 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use fuzzyvox::figure::ViewColor;
 use fuzzyvox::io::load_map;
 use fuzzyvox::view::{DEFAULT_MAX_FREE, ViewerOptions, read_paths, write_viewer_page};
 use serde_json::json;
 
+use super::maps::ColorArg;
 use super::progress;
 
 /// Write a 3D viewer page for a map: one self-contained HTML file that opens offline by double
@@ -49,16 +50,6 @@ pub struct ViewArgs {
     json: bool,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum ColorArg {
-    Class,
-    Height,
-    Occupied,
-    Free,
-    Ambiguity,
-    Safety,
-}
-
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     let out = args
         .out
@@ -77,14 +68,7 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         format!("{name} ({} map)", map.model_name()),
         map.model_name(),
     );
-    options.color = match args.color {
-        ColorArg::Class => ViewColor::Class,
-        ColorArg::Height => ViewColor::Height,
-        ColorArg::Occupied => ViewColor::Occupied,
-        ColorArg::Free => ViewColor::Free,
-        ColorArg::Ambiguity => ViewColor::Ambiguity,
-        ColorArg::Safety => ViewColor::Safety,
-    };
+    options.color = ViewColor::from(args.color);
     options.max_free = args.max_free;
     options.show_free = args.show_free;
     options.paths = paths;

@@ -13,25 +13,21 @@ pub fn maps_chart(report: &ExperimentReport) -> Chart {
         .filter_map(|n| Some((n, report.maps.get(n)?)))
         .collect();
     let names: Vec<String> = maps.iter().map(|(n, _)| n.to_string()).collect();
-    let metric = |f: &dyn Fn(&super::MapMetrics) -> f64| -> Vec<Option<f64>> {
-        maps.iter().map(|(_, m)| Some(f(&m.metrics))).collect()
-    };
+    let reports: Vec<&super::MapReport> = maps.iter().map(|(_, m)| *m).collect();
     let mut panels = vec![
-        Panel::Bars(BarPanel {
-            title: "holes (truly occupied, not occupied)".into(),
-            values: metric(&|m| m.holes as f64),
-            range: None,
-        }),
-        Panel::Bars(BarPanel {
-            title: "spurious (occupied in unknown space)".into(),
-            values: metric(&|m| m.spurious_unknown as f64),
-            range: None,
-        }),
-        Panel::Bars(BarPanel {
-            title: "occupied F1".into(),
-            values: metric(&|m| m.occupied_f1),
-            range: Some([0.0, 1.0]),
-        }),
+        metric_bars(
+            &reports,
+            "holes (truly occupied, not occupied)",
+            None,
+            |m| m.holes as f64,
+        ),
+        metric_bars(
+            &reports,
+            "spurious (occupied in unknown space)",
+            None,
+            |m| m.spurious_unknown as f64,
+        ),
+        metric_bars(&reports, "occupied F1", Some([0.0, 1.0]), |m| m.occupied_f1),
     ];
     if maps.iter().any(|(_, m)| m.flights.is_some()) {
         panels.push(Panel::Bars(BarPanel {
@@ -54,6 +50,20 @@ pub fn maps_chart(report: &ExperimentReport) -> Chart {
     }
 }
 
+/// A bar per map of one metric.
+fn metric_bars(
+    maps: &[&super::MapReport],
+    title: &str,
+    range: Option<[f64; 2]>,
+    metric: impl Fn(&super::MapMetrics) -> f64,
+) -> Panel {
+    Panel::Bars(BarPanel {
+        title: title.into(),
+        values: maps.iter().map(|m| Some(metric(&m.metrics))).collect(),
+        range,
+    })
+}
+
 /// The fuzzy maps built with different t-conorms (`fuzzy`, the probabilistic sum, and each
 /// `fuzzy:OP`), side by side, named by operator; `None` when the experiment built only one.
 pub fn operators_chart(report: &ExperimentReport) -> Option<Chart> {
@@ -65,9 +75,7 @@ pub fn operators_chart(report: &ExperimentReport) -> Option<Chart> {
     if fuzzy.len() < 2 {
         return None;
     }
-    let metric = |f: &dyn Fn(&super::MapMetrics) -> f64| -> Vec<Option<f64>> {
-        fuzzy.iter().map(|(_, m)| Some(f(&m.metrics))).collect()
-    };
+    let reports: Vec<&super::MapReport> = fuzzy.iter().map(|(_, m)| *m).collect();
     Some(Chart {
         title: format!(
             "{} scenario: fuzzy maps by aggregation operator",
@@ -81,25 +89,15 @@ pub fn operators_chart(report: &ExperimentReport) -> Option<Chart> {
             })
             .collect(),
         panels: vec![
-            Panel::Bars(BarPanel {
-                title: "occupied precision".into(),
-                values: metric(&|m| m.occupied_precision),
-                range: Some([0.0, 1.0]),
+            metric_bars(&reports, "occupied precision", Some([0.0, 1.0]), |m| {
+                m.occupied_precision
             }),
-            Panel::Bars(BarPanel {
-                title: "occupied recall".into(),
-                values: metric(&|m| m.occupied_recall),
-                range: Some([0.0, 1.0]),
+            metric_bars(&reports, "occupied recall", Some([0.0, 1.0]), |m| {
+                m.occupied_recall
             }),
-            Panel::Bars(BarPanel {
-                title: "holes".into(),
-                values: metric(&|m| m.holes as f64),
-                range: None,
-            }),
-            Panel::Bars(BarPanel {
-                title: "spurious (unknown space)".into(),
-                values: metric(&|m| m.spurious_unknown as f64),
-                range: None,
+            metric_bars(&reports, "holes", None, |m| m.holes as f64),
+            metric_bars(&reports, "spurious (unknown space)", None, |m| {
+                m.spurious_unknown as f64
             }),
         ],
         columns: 2,

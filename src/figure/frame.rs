@@ -259,8 +259,9 @@ pub(crate) fn draw_legend<DB: DrawingBackend>(
                 ))
                 .map_err(figure_error)?;
             }
+            // The frame lies just outside the bar, so that both ends of the colour map show.
             area.draw(&Rectangle::new(
-                [(x, y), (x + 24, y + bar)],
+                [(x - 1, y - 1), (x + 25, y + bar)],
                 BLACK.stroke_width(1),
             ))
             .map_err(figure_error)?;

@@ -137,7 +137,7 @@ pub fn image_figure(title: &str, panels: &[ImagePanel], columns: usize) -> Resul
                 .map_err(figure_error)?;
             }
             body.draw(&Rectangle::new(
-                [(cx, bar_y), (cx + bar_w, bar_y + 12)],
+                [(cx - 1, bar_y - 1), (cx + bar_w, bar_y + 13)],
                 BLACK.stroke_width(1),
             ))
             .map_err(figure_error)?;

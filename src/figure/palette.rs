@@ -33,11 +33,17 @@ pub const BACKGROUND: [u8; 3] = [255, 255, 255];
 /// Pixels without a value in depth, disparity and confidence images.
 pub const NO_VALUE: [u8; 3] = [0, 0, 0];
 
-/// Flights that stay clear of the true scene, and trajectories.
+/// Flights that stay clear of the true scene (and trajectories in figures).
 pub const PATH_OK: [u8; 3] = [20, 60, 200];
 
 /// Flights that meet the true scene.
 pub const PATH_COLLIDES: [u8; 3] = [220, 30, 30];
+
+/// The camera's trajectory, in the viewer page.
+pub const PATH_TRAJECTORY: [u8; 3] = [150, 60, 190];
+
+/// Paths of no known kind, in the viewer page.
+pub const PATH_OTHER: [u8; 3] = [90, 90, 90];
 
 /// Viridis sampled at nine evenly spaced stops; [`viridis`] interpolates between them. The
 /// viewer page uses the same stops.

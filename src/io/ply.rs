@@ -13,6 +13,7 @@ use std::path::Path;
 
 use super::atomic::write_atomic_with;
 use crate::error::Result;
+pub use crate::figure::palette::class_color;
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
 
@@ -23,17 +24,6 @@ pub enum PlyEncoding {
     Ascii,
     /// Packed little-endian records of 32 bytes (seven `f32`, four `u8`).
     BinaryLittleEndian,
-}
-
-/// The colour of a class in exports: occupied near black, free light green, ambiguous orange,
-/// unknown white.
-pub fn class_color(class: VoxelClass) -> [u8; 3] {
-    match class {
-        VoxelClass::Occupied => [40, 40, 40],
-        VoxelClass::Free => [170, 220, 170],
-        VoxelClass::Ambiguous => [235, 140, 30],
-        VoxelClass::Unknown => [255, 255, 255],
-    }
 }
 
 /// Writes every observed voxel of `map` whose class is in `classes` to a PLY file at `path`

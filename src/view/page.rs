@@ -17,7 +17,9 @@ use serde_json::json;
 
 use crate::error::{Error, Result};
 use crate::figure::ViewColor;
-use crate::figure::palette::class_color;
+use crate::figure::palette::{
+    PATH_COLLIDES, PATH_OK, PATH_OTHER, PATH_TRAJECTORY, VIRIDIS, class_color,
+};
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
 use crate::storage::VoxelKey;
@@ -242,16 +244,51 @@ pub fn viewer_page(map: &dyn VoxelMap, options: &ViewerOptions) -> Result<(Strin
         "window.FUZZYVOX_DATA = {};",
         data.to_string().replace('<', "\\u003c")
     );
-    let page = TEMPLATE
-        .replacen("{{TITLE}}", &escape_html(&options.title), 2)
-        .replacen("/*FUZZYVOX_DATA*/", &data, 1)
-        .replacen("/*FUZZYVOX_VIEWER_JS*/", SCRIPT, 1);
+    // The script's colour map is the figures' own (one table for both).
+    let stops: Vec<String> = VIRIDIS
+        .iter()
+        .map(|[r, g, b]| format!("[{r}, {g}, {b}]"))
+        .collect();
+    let path_colors = format!(
+        "trajectory: {:?}, flight: {:?}, failed: {:?}, other: {:?}",
+        PATH_TRAJECTORY, PATH_OK, PATH_COLLIDES, PATH_OTHER
+    );
+    let script = SCRIPT
+        .replacen("/*FUZZYVOX_VIRIDIS*/", &stops.join(", "), 1)
+        .replacen("/*FUZZYVOX_PATH_COLORS*/", &path_colors, 1);
+    let page = fill_template(
+        TEMPLATE,
+        &[
+            ("{{TITLE}}", &escape_html(&options.title)),
+            ("/*FUZZYVOX_DATA*/", &data),
+            ("/*FUZZYVOX_VIEWER_JS*/", &script),
+        ],
+    );
     let summary = PageSummary {
         drawn: by_class.each_ref().map(Vec::len),
         total,
         bytes: page.len(),
     };
     Ok((page, summary))
+}
+
+/// `template` with each placeholder replaced by its text. Only the template is searched, never
+/// the text put in, so a title or path name that happens to spell a placeholder stays as it is.
+fn fill_template(template: &str, fills: &[(&str, &str)]) -> String {
+    let mut page =
+        String::with_capacity(template.len() + fills.iter().map(|f| f.1.len()).sum::<usize>());
+    let mut rest = template;
+    while let Some((at, (placeholder, text))) = fills
+        .iter()
+        .filter_map(|fill| rest.find(fill.0).map(|at| (at, fill)))
+        .min_by_key(|(at, _)| *at)
+    {
+        page.push_str(&rest[..at]);
+        page.push_str(text);
+        rest = &rest[at + placeholder.len()..];
+    }
+    page.push_str(rest);
+    page
 }
 
 /// Writes the page for `map` to `path` atomically (see [`viewer_page`]).
@@ -348,6 +385,35 @@ mod tests {
         let x = u16::from_le_bytes([bytes[0], bytes[1]]);
         let origin = data["origin"][0].as_f64().unwrap();
         assert!((origin + (f64::from(x) + 0.5) * 0.1 - 2.05).abs() < 1e-9);
+    }
+
+    #[test]
+    fn placeholders_in_titles_and_path_names_stay_as_they_are() {
+        let map = map();
+        let mut options = ViewerOptions::new("/*FUZZYVOX_VIEWER_JS*/ {{TITLE}}", "fuzzy");
+        options.paths.push(PagePath {
+            name: "/*FUZZYVOX_VIEWER_JS*/".into(),
+            kind: PathKind::Flight,
+            ok: true,
+            points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.5]],
+        });
+        let (page, _) = viewer_page(&map, &options).unwrap();
+        let data = data_of(&page);
+        assert_eq!(data["title"], "/*FUZZYVOX_VIEWER_JS*/ {{TITLE}}");
+        assert_eq!(data["paths"][0]["name"], "/*FUZZYVOX_VIEWER_JS*/");
+        // The script went where the template wants it, once.
+        assert_eq!(page.matches("fuzzyvox map viewer.").count(), 1);
+        assert!(!page.contains("/*FUZZYVOX_VIRIDIS*/"));
+        assert!(!page.contains("/*FUZZYVOX_PATH_COLORS*/"));
+    }
+
+    #[test]
+    fn the_script_uses_the_figures_viridis_stops() {
+        let (page, _) = viewer_page(&map(), &ViewerOptions::new("wall", "fuzzy")).unwrap();
+        let start = page.find("const VIRIDIS = [").unwrap() + "const VIRIDIS = ".len();
+        let end = start + page[start..].find(';').unwrap();
+        let stops: Vec<[u8; 3]> = serde_json::from_str(&page[start..end]).unwrap();
+        assert_eq!(stops, VIRIDIS);
     }
 
     #[test]

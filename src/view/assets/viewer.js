@@ -55,18 +55,16 @@
     { id: "ambiguity", label: "ambiguity" },
     { id: "safety", label: "safety" },
   ];
-  // Matplotlib's viridis colour map sampled at 9 evenly spaced stops (sRGB, 0-255). Both the
+  // Matplotlib's viridis colour map sampled at evenly spaced stops (sRGB, 0-255). Both the
   // shader and the legend interpolate linearly between these stops.
-  const VIRIDIS = [
-    [68, 1, 84], [71, 45, 123], [59, 82, 139], [44, 114, 142], [33, 144, 140],
-    [39, 173, 129], [93, 200, 99], [170, 220, 50], [253, 231, 37],
-  ];
-  const PATH_COLORS = {
-    trajectory: [0.16, 0.42, 0.86, 1],
-    flight: [0.07, 0.07, 0.07, 1],
-    failed: [0.88, 0.12, 0.1, 1],
-    other: [0.55, 0.3, 0.72, 1],
-  };
+  // The stops are written in by the Rust side from fuzzyvox::figure::palette::VIRIDIS, the
+  // figures' own table.
+  const VIRIDIS = [/*FUZZYVOX_VIRIDIS*/];
+  // Path colours (sRGB, 0-255), written in from fuzzyvox::figure::palette like the stops
+  // above: trajectories, flights clear of the true scene, flights that meet it, and others.
+  const PATH_RGB = {/*FUZZYVOX_PATH_COLORS*/};
+  const PATH_COLORS = Object.fromEntries(
+    Object.entries(PATH_RGB).map(([kind, rgb]) => [kind, [...rgb.map((c) => c / 255), 1]]));
   const BACKGROUND = [0xf4 / 255, 0xf4 / 255, 0xf0 / 255];
   const FOV_Y = (45 * Math.PI) / 180;
   const RECORD_BYTES = 16;
@@ -283,11 +281,14 @@ vec3 viridis(float t) {
   return mix(VIRIDIS[i], VIRIDIS[i + 1], x - float(i));
 }`;
 
-  // Voxels are drawn by vertex pulling: plain (not instanced) draw calls whose shader reads
+  // Voxels are drawn by vertex pulling, one instanced draw call per class: the shader reads
   // each voxel's record from a texture holding the record bytes as they are (two RGBA16UI
-  // texels per 16-byte record). Software renderers handle each instance of an instanced draw
-  // as a separate draw, which made a few hundred thousand instanced cubes take seconds per
-  // frame; large plain draws take a fraction of that, and GPUs do not mind either way.
+  // texels per 16-byte record), and each instance is a block of voxels (CUBE_BLOCK cubes or
+  // POINT_BLOCK points) rather than one voxel. Software renderers (SwiftShader, what a machine
+  // without a GPU has) handle each instance as a separate draw, which made one instance per
+  // voxel take seconds per frame for a few hundred thousand cubes; blocks keep the instance
+  // count in the hundreds for a million voxels, and GPUs do not mind either way. The last
+  // block's records past the class's end are moved outside the clip volume.
   //
   // A cube shows the three faces turned towards the eye. They share the cube corner nearest to
   // the eye and form a hexagon around it: 7 vertices and 6 triangles (CUBE_TRIANGLES, shared
@@ -295,7 +296,8 @@ vec3 viridis(float t) {
   // shader finds each face's normal from screen-space derivatives. A point (free and unknown
   // voxels) is one vertex, sized to the voxel's projected edge.
   const CUBE_TRIANGLES = [0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5, 0, 5, 6, 0, 6, 1];
-  const CUBE_CHUNK = 32768; // cubes per draw call, so the index buffer stays small
+  const CUBE_BLOCK = 16384; // cubes per instance; the index buffer holds one block
+  const POINT_BLOCK = 65536; // points per instance
 
   const VOXEL_VS = `#version 300 es
 precision highp float;
@@ -310,7 +312,9 @@ uniform vec2 uHeight;          // z range of the height colour map, relative to 
 uniform int uMode;             // index in COLOR_MODES
 uniform vec3 uClassColor[4];
 uniform float uClassScale[4];
-uniform int uStart;            // first record of this draw call
+uniform int uStart;            // first record of this class
+uniform int uEnd;              // one past its last record
+uniform int uBlock;            // records per instance
 uniform bool uPoints;          // one point per voxel instead of a cube
 uniform vec2 uPointSize;       // device pixels per metre at unit depth, largest point size
 out vec3 vWorld;
@@ -321,7 +325,16 @@ ${GLSL_VIRIDIS}
 const vec3 HEXAGON[7] = vec3[](vec3(1, 1, 1), vec3(1, -1, 1), vec3(1, -1, -1), vec3(1, 1, -1),
                                vec3(-1, 1, -1), vec3(-1, 1, 1), vec3(-1, -1, 1));
 void main() {
-  int record = uStart + (uPoints ? gl_VertexID : gl_VertexID / 7);
+  int record = uStart + gl_InstanceID * uBlock + (uPoints ? gl_VertexID : gl_VertexID / 7);
+  if (record >= uEnd) {
+    // Past the class's last record (in the last block): outside the clip volume, not drawn.
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
+    gl_PointSize = 1.0;
+    vWorld = vec3(0.0);
+    vBase = vec3(0.0);
+    vId = 0u;
+    return;
+  }
   int width = textureSize(uVoxels, 0).x;
   ivec2 at = ivec2((2 * record) % width, (2 * record) / width);  // width is even
   uvec4 a = texelFetch(uVoxels, at, 0);
@@ -540,10 +553,12 @@ void main() {
       if (rest > 0) upload(fullRows, rest, 1, fullRows * texWidth * 4);
     }
     // The voxel shader reads no vertex attributes, only the indices of the cube triangles.
+    const cubeBlock = Math.min(CUBE_BLOCK, Math.max(1, ...map.classes
+      .filter((c) => !CLASS_AS_POINTS[c.index]).map((c) => c.count)));
     const voxelVao = gl.createVertexArray();
     gl.bindVertexArray(voxelVao);
     {
-      const cubes = Math.min(CUBE_CHUNK, Math.max(1, ...map.classes.filter((c) => !CLASS_AS_POINTS[c.index]).map((c) => c.count)));
+      const cubes = cubeBlock;
       const indices = new Uint32Array(cubes * CUBE_TRIANGLES.length);
       for (let v = 0, i = 0; v < cubes; v++) {
         for (const corner of CUBE_TRIANGLES) indices[i++] = v * 7 + corner;
@@ -670,21 +685,21 @@ void main() {
       gl.activeTexture(gl.TEXTURE0);
       gl.bindTexture(gl.TEXTURE_2D, voxelTexture);
       gl.uniform2f(vu.uPointSize, canvas.height / (2 * Math.tan(FOV_Y / 2)), maxPointSize);
-      // Records of a class are contiguous: one draw call per class of points, one per
-      // CUBE_CHUNK voxels of a class of cubes.
+      // Records of a class are contiguous: one instanced draw call per class.
       for (const c of map.classes) {
         if (!state.shown[c.index] || c.count === 0) continue;
         const points = CLASS_AS_POINTS[c.index];
         gl.uniform1i(vu.uPoints, points ? 1 : 0);
+        gl.uniform1i(vu.uStart, c.start);
+        gl.uniform1i(vu.uEnd, c.start + c.count);
         if (points) {
-          gl.uniform1i(vu.uStart, c.start);
-          gl.drawArrays(gl.POINTS, 0, c.count);
-          continue;
-        }
-        for (let first = 0; first < c.count; first += CUBE_CHUNK) {
-          gl.uniform1i(vu.uStart, c.start + first);
-          const cubes = Math.min(CUBE_CHUNK, c.count - first);
-          gl.drawElements(gl.TRIANGLES, cubes * CUBE_TRIANGLES.length, gl.UNSIGNED_INT, 0);
+          const block = Math.min(POINT_BLOCK, c.count);
+          gl.uniform1i(vu.uBlock, block);
+          gl.drawArraysInstanced(gl.POINTS, 0, block, Math.ceil(c.count / block));
+        } else {
+          gl.uniform1i(vu.uBlock, cubeBlock);
+          gl.drawElementsInstanced(gl.TRIANGLES, cubeBlock * CUBE_TRIANGLES.length,
+            gl.UNSIGNED_INT, 0, Math.ceil(c.count / cubeBlock));
         }
       }
       gl.bindVertexArray(null);
