@@ -239,21 +239,24 @@ fn demo_writes_the_report_maps_and_figures() {
             }
         }
     }
-    // The report and the fuzzy map's viewer page open in a browser without console errors,
-    // and the page shows the map.
+    // The report and every viewer page open in a browser without console errors, and each
+    // page shows its map.
     if let Some(browser) = Browser::find("demo_writes_the_report_maps_and_figures (browser)") {
         let report_html = out.join("report.html");
         let run = browser.dump_dom(&report_html, "");
         assert!(run.console_errors().is_empty(), "{:#?}", run.console);
         assert!(run.dom.contains("<img"), "report.html shows no figures");
         for scenario in ["wall", "random"] {
-            let page = out.join(format!("{scenario}-fuzzy.html"));
-            let shot = out.join(format!("{scenario}-fuzzy-shot.png"));
-            let colors = browser.check_viewer_page(&page, "", &shot);
-            assert!(
-                colors >= 20,
-                "{scenario}: the screenshot has only {colors} colours"
-            );
+            for map in ["logodds", "alpha", "fuzzy"] {
+                let page = out.join(format!("{scenario}-{map}.html"));
+                let shot = out.join(format!("{scenario}-{map}-shot.png"));
+                let colors = browser.check_viewer_page(&page, "", &shot);
+                assert!(
+                    colors >= 20,
+                    "{scenario}-{map}: the screenshot has only {colors} colours"
+                );
+                eprintln!("{scenario}-{map}.html: ready, {colors} colours");
+            }
         }
     }
     std::fs::remove_dir_all(&out).unwrap();

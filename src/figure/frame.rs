@@ -265,9 +265,8 @@ pub(crate) fn draw_legend<DB: DrawingBackend>(
                 BLACK.stroke_width(1),
             ))
             .map_err(figure_error)?;
-            for i in 0..=4 {
-                let t = f64::from(i) / 4.0;
-                let value = range[0] + (range[1] - range[0]) * t;
+            for value in bar_ticks(*range) {
+                let t = (value - range[0]) / (range[1] - range[0]);
                 let ty = y + ((1.0 - t) * f64::from(bar - 1)) as i32;
                 area.draw(&PathElement::new(vec![(x + 24, ty), (x + 30, ty)], BLACK))
                     .map_err(figure_error)?;
@@ -278,6 +277,28 @@ pub(crate) fn draw_legend<DB: DrawingBackend>(
         }
     }
     Ok(())
+}
+
+/// The values labelled on a colour bar over `range`: its two ends, and the round values
+/// (multiples of 1, 2 or 5 × 10ⁿ, about three of them) between them that are not too close to
+/// an end.
+pub fn bar_ticks(range: [f64; 2]) -> Vec<f64> {
+    let [lo, hi] = range;
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return vec![lo];
+    }
+    let step = nice_length((hi - lo) / 3.0);
+    let mut ticks = vec![lo];
+    let mut k = (lo / step).ceil();
+    while k * step < hi {
+        let value = k * step;
+        if value - lo > 0.4 * step && hi - value > 0.4 * step {
+            ticks.push(value);
+        }
+        k += 1.0;
+    }
+    ticks.push(hi);
+    ticks
 }
 
 /// A tick label: at most three decimals, no trailing zeros.
@@ -321,6 +342,21 @@ pub(crate) fn figure_error<E: std::error::Error + Send + Sync>(e: E) -> Error {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn colour_bars_label_their_ends_and_round_values() {
+        let close = |range: [f64; 2], expected: &[f64]| {
+            let ticks = bar_ticks(range);
+            assert_eq!(ticks.len(), expected.len(), "{ticks:?}");
+            for (t, e) in ticks.iter().zip(expected) {
+                assert!((t - e).abs() < 1e-12, "{ticks:?}");
+            }
+        };
+        close([0.3, 8.0], &[0.3, 2.0, 4.0, 6.0, 8.0]);
+        close([0.0, 1.0], &[0.0, 0.2, 0.4, 0.6, 0.8, 1.0]);
+        close([-1.07, 10.18], &[-1.07, 0.0, 2.0, 4.0, 6.0, 8.0, 10.18]);
+        close([1.0, 1.0], &[1.0]);
+    }
 
     #[test]
     fn scale_bars_have_round_lengths() {
