@@ -515,7 +515,7 @@ fn stereo_rejects_bad_inputs_without_panicking() {
 
 /// The `fuzzyvox plan` examples in a text: lines of the form `fuzzyvox plan ...` or
 /// `cargo run --release -- plan ...` (after an optional `$ ` prompt, without a trailing
-/// `# comment`), skipping synopses (`X,Y,Z`). An example followed by a line that starts with
+/// `# comment` or `> file`), skipping synopses (`X,Y,Z`). An example followed by a line that starts with
 /// `error:` is expected to fail with that line's first words.
 fn plan_examples(text: &str) -> Vec<(String, Option<String>)> {
     let lines: Vec<&str> = text.lines().map(str::trim).collect();
@@ -526,7 +526,14 @@ fn plan_examples(text: &str) -> Vec<(String, Option<String>)> {
         if !line.starts_with("fuzzyvox plan ") || line.contains("X,Y,Z") {
             continue;
         }
-        let command = line.split(" #").next().unwrap_or(&line).trim().to_string();
+        // A trailing comment or redirection of the output is the shell's, not the command's.
+        let command = line.split(" #").next().unwrap_or(&line);
+        let command = command
+            .split(" > ")
+            .next()
+            .unwrap_or(command)
+            .trim()
+            .to_string();
         let error = lines
             .get(i + 1)
             .filter(|next| next.starts_with("error:"))
