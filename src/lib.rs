@@ -50,6 +50,7 @@ pub mod depth;
 mod error;
 pub mod eval;
 pub mod figure;
+pub mod fly;
 pub mod geometry;
 pub mod integrate;
 pub mod io;

@@ -4,6 +4,7 @@
 mod demo;
 mod eval;
 mod export;
+mod fly;
 mod held_out;
 mod info;
 mod input;
@@ -61,6 +62,7 @@ enum Command {
     Rgbd(rgbd::RgbdArgs),
     Mono(mono::MonoArgs),
     View(view::ViewArgs),
+    Fly(fly::FlyArgs),
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
@@ -78,6 +80,7 @@ pub fn run() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Rgbd(args) => rgbd::run(args),
         Command::Mono(args) => mono::run(args),
+        Command::Fly(args) => fly::run(args),
         Command::View(args) => view::run(args),
     };
     match result {

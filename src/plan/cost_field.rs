@@ -335,7 +335,9 @@ impl CostField {
 }
 
 /// Whether a voxel of this class and safety is blocked under `config`.
-fn is_blocked(class: VoxelClass, safety: f32, config: &PlannerConfig) -> bool {
+/// Whether a voxel of `class` and `safety` is blocked under `config` (occupied, ambiguous, free
+/// with safety below the threshold, or unknown while unknown space is forbidden).
+pub fn is_blocked(class: VoxelClass, safety: f32, config: &PlannerConfig) -> bool {
     match class {
         VoxelClass::Occupied | VoxelClass::Ambiguous => true,
         VoxelClass::Unknown => !matches!(config.unknown, UnknownPolicy::Cost(_)),

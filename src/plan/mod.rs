@@ -27,7 +27,7 @@ mod queries;
 pub use astar::{Path, PlanError, plan_in_field, plan_path};
 pub use blocker::{Blocker, NearestBlocked, ObservedExtent};
 pub use config::{PlannerConfig, UnknownPolicy};
-pub use cost_field::{CostField, PlanningRegion};
+pub use cost_field::{CostField, PlanningRegion, is_blocked};
 pub use edt::squared_distance_transform;
 pub use graph::{VoxelEdge, VoxelGraph};
 pub use queries::SafetyQueries;

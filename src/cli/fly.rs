@@ -1,0 +1,238 @@
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use clap::{Args, ValueEnum};
+use fuzzyvox::figure::palette::{PATH_COLLIDES, PATH_OK};
+use fuzzyvox::figure::{Overlay, View, ViewColor, ViewSpec, save_png, view_figure};
+use fuzzyvox::fly::{Ending, FlyConfig, FlyModel, draw_goals, fly_all};
+use fuzzyvox::plan::UnknownPolicy;
+use serde_json::{Value, json};
+
+use super::eval::ScenarioName;
+use super::plan::Unknown;
+
+/// Fly closed-loop flights: a simulated vehicle with one camera flies from a start to a goal
+/// through a scenario it has not seen. Every frame it renders its camera, estimates depth from
+/// its own motion (plane sweep when it flies towards what it looks at), updates its map, keeps
+/// or replans its path, and advances; the true scene checks every step with the vehicle's
+/// swept ball. Each map flies its own flight from the same start to the same goal.
+///
+/// See docs/flight.md for the loop, its parameters and results.
+#[derive(Args)]
+#[command(after_help = "Examples:\n  \
+    fuzzyvox fly --scenario random --seed 3 --goals 5\n  \
+    fuzzyvox fly --scenario wall --goals 3 --model fuzzy,logodds --json\n  \
+    fuzzyvox fly --scenario random --goals 20 --out fly-random   # fly.json and a figure per flight")]
+pub struct FlyArgs {
+    /// Which scenario's scene to fly through.
+    #[arg(long, value_enum)]
+    scenario: ScenarioName,
+    /// Seed of the scene (random scenario), the goals and the sensor noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Number of flights (start/goal pairs) per map.
+    #[arg(long, default_value_t = 5)]
+    goals: usize,
+    /// Maps to fly with: `all`, or a comma-separated list of fuzzy, logodds, alpha.
+    #[arg(long, value_delimiter = ',', default_value = "all")]
+    model: Vec<ModelArg>,
+    /// Camera views per depth image: 2 matches each frame against the previous one; N > 2
+    /// adds earlier frames (multiple-baseline plane sweep).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=17))]
+    views: u32,
+    /// Unknown space: allowed at a cost (default: goals lie in space not seen yet), or
+    /// forbidden (the vehicle flies to the known-safe voxel nearest the goal and looks again).
+    #[arg(long, value_enum, default_value_t = Unknown::Cost)]
+    unknown: Unknown,
+    /// Extra cost per metre through unknown space; only with `--unknown cost` [default: 2].
+    #[arg(long, value_name = "C")]
+    unknown_cost: Option<f32>,
+    /// Write fly.json and a top-down figure of each flight over its final map here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ModelArg {
+    All,
+    Fuzzy,
+    Logodds,
+    Alpha,
+}
+
+pub fn run(args: FlyArgs) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let mut models = Vec::new();
+    for m in &args.model {
+        let add: &[FlyModel] = match m {
+            ModelArg::All => &FlyModel::ALL,
+            ModelArg::Fuzzy => &[FlyModel::Fuzzy],
+            ModelArg::Logodds => &[FlyModel::LogOdds],
+            ModelArg::Alpha => &[FlyModel::Alpha],
+        };
+        for model in add {
+            if !models.contains(model) {
+                models.push(*model);
+            }
+        }
+    }
+    if args.goals == 0 {
+        bail!("--goals must be at least 1");
+    }
+    let mut config = FlyConfig {
+        views: args.views as usize,
+        ..FlyConfig::default()
+    };
+    config.planner.unknown = match (args.unknown, args.unknown_cost) {
+        (Unknown::Cost, cost) => UnknownPolicy::Cost(cost.unwrap_or(2.0)),
+        (Unknown::Forbid, None) => UnknownPolicy::Forbid,
+        (Unknown::Forbid, Some(_)) => bail!("--unknown-cost applies only with --unknown cost"),
+    };
+    let config = config.validate()?;
+    if let Some(out) = &args.out
+        && out.exists()
+        && !out.is_dir()
+    {
+        bail!("--out {} exists and is not a folder", out.display());
+    }
+    let scenario = args.scenario.build(2, args.seed)?;
+    let goals = draw_goals(&scenario, &config, args.goals, args.seed)?;
+    if goals.is_empty() {
+        bail!(
+            "no start and goal could be drawn in the {} scenario",
+            scenario.name
+        );
+    }
+    let label = format!("{} scenario", scenario.name);
+    let bar = super::progress::bar((goals.len() * models.len()) as u64, &label, args.json);
+    let flights = fly_all(
+        &scenario,
+        &goals,
+        &models,
+        &config,
+        args.seed,
+        args.out.is_some(),
+        &mut |done, _| bar.set_position(done as u64),
+    )?;
+    bar.finish_and_clear();
+
+    let mut maps = serde_json::Map::new();
+    for model in &flights {
+        let mut entry = serde_json::to_value(model.summary(&goals))?;
+        entry["flights"] = Value::Array(
+            model
+                .flights
+                .iter()
+                .map(|f| {
+                    json!({
+                        "ending": f.ending,
+                        "length_m": f.length,
+                        "seconds": f.seconds,
+                        "frames": f.frames,
+                        "depth_images": f.depth_images,
+                        "depth_refused": f.depth_refused,
+                        "replans": f.replans,
+                        "trajectory": f.trajectory.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    })
+                })
+                .collect(),
+        );
+        maps.insert(model.model.name().to_string(), entry);
+    }
+    let report = json!({
+        "scenario": scenario.name,
+        "seed": args.seed,
+        "goals": goals.len(),
+        "goal_list": goals,
+        "config": config,
+        "maps": maps,
+        "seconds": started.elapsed().as_secs_f64(),
+    });
+    if let Some(out) = &args.out {
+        std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+        let file = out.join("fly.json");
+        fuzzyvox::io::write_atomic(&file, serde_json::to_string_pretty(&report)?.as_bytes())?;
+        for model in &flights {
+            for (i, (flight, map)) in model.flights.iter().zip(&model.maps).enumerate() {
+                let goal = &goals[i];
+                let mut spec = ViewSpec::new(View::Top, ViewColor::Height);
+                let margin = 4.0;
+                spec.window = Some([
+                    [
+                        goal.start.x.min(goal.goal.x) - margin,
+                        goal.start.x.max(goal.goal.x) + margin,
+                    ],
+                    [
+                        goal.start.y.min(goal.goal.y) - margin,
+                        goal.start.y.max(goal.goal.y) + margin,
+                    ],
+                ]);
+                spec.floor = Some(0.3);
+                let overlays = vec![
+                    Overlay {
+                        points: flight.trajectory.iter().map(|p| [p.x, p.y]).collect(),
+                        color: if flight.ending == Ending::Collided {
+                            PATH_COLLIDES
+                        } else {
+                            PATH_OK
+                        },
+                        mark_start: true,
+                    },
+                    Overlay {
+                        points: vec![[goal.goal.x, goal.goal.y], [goal.goal.x, goal.goal.y]],
+                        color: PATH_COLLIDES,
+                        mark_start: true,
+                    },
+                ];
+                let title = format!(
+                    "{} scenario, {} map, flight {}: {:?}, {:.1} m",
+                    scenario.name,
+                    model.model.name(),
+                    i + 1,
+                    flight.ending,
+                    flight.length
+                );
+                let figure = view_figure(map.as_map(), &spec, &title, overlays, 1)?;
+                save_png(
+                    &figure,
+                    &out.join(format!("fly-{}-{}.png", model.model.name(), i + 1)),
+                )?;
+            }
+        }
+    }
+    if args.json {
+        return super::print_json(&report);
+    }
+    println!(
+        "{} scenario, seed {}: {} flights per map ({:.0} s)",
+        scenario.name,
+        args.seed,
+        goals.len(),
+        started.elapsed().as_secs_f64()
+    );
+    for model in &flights {
+        let s = model.summary(&goals);
+        println!(
+            "  {:8} reached {:>3.0} %, collisions {}, no path {}, out of time {}; length / true path {}; \
+             per cycle: depth {:.0} ms, integration {:.0} ms, update and replan {:.1} ms (full rebuild {:.0} ms)",
+            model.model.name(),
+            s.reached * 100.0,
+            s.collisions,
+            s.no_path,
+            s.time_limit,
+            s.length_ratio.map_or("n/a".into(), |r| format!("{r:.2}")),
+            s.depth_ms,
+            s.integrate_ms,
+            s.update_replan_ms,
+            s.full_rebuild_ms,
+        );
+    }
+    if let Some(out) = &args.out {
+        println!("wrote {}", out.join("fly.json").display());
+    }
+    Ok(())
+}

@@ -1,0 +1,130 @@
+//! The closed loop's parameters.
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::plan::{PlannerConfig, UnknownPolicy};
+
+/// Every setting of a closed-loop flight, in one value.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FlyConfig {
+    /// Voxel size of the maps, metres. Default 0.2.
+    pub resolution: f64,
+    /// Cruise speed, metres per second. Default 2.
+    pub speed: f64,
+    /// Time between frames, seconds: each cycle advances `speed × frame_interval` metres.
+    /// Default 0.25 (0.5 m per frame).
+    pub frame_interval: f64,
+    /// A flight that has not reached its goal after this many seconds ends. Default: 60.
+    pub time_limit: f64,
+    /// Camera views per depth image (2: the current and the previous frame). Default 2.
+    pub views: usize,
+    /// Planner settings; the vehicle radius is also the radius of the collision check against
+    /// the true scene. Default: the planner's defaults with unknown space allowed at a cost of
+    /// 2 per metre (goals lie in space nobody has seen yet).
+    pub planner: PlannerConfig,
+    /// Radius of the prior map around the start, metres: what the vehicle knows before it
+    /// takes off (the true surfaces and free space within this distance, seen from the start
+    /// in six directions). Default 2.
+    pub prior_radius: f64,
+    /// The camera looks at the point this far ahead along the current path (horizontally).
+    /// Default 3 m.
+    pub look_ahead: f64,
+    /// The planner keeps its path while it stays valid, but replans at least every this many
+    /// frames to use what the map has learnt. Default 8.
+    pub replan_every: usize,
+    /// Horizontal margin of the planning region around start and goal, metres. Default 6.
+    pub region_margin: f64,
+    /// Lowest and highest altitude of starts and goals, metres. Default 1.5 to 6.
+    pub altitude: (f64, f64),
+    /// Shortest and longest straight-line distance between start and goal, metres. Default 8
+    /// to 20.
+    pub distance: (f64, f64),
+    /// Extra distance beyond the vehicle radius that starts and goals keep from every true
+    /// surface, metres. Default 0.5.
+    pub surface_margin: f64,
+}
+
+impl Default for FlyConfig {
+    fn default() -> Self {
+        Self {
+            resolution: 0.2,
+            speed: 2.0,
+            frame_interval: 0.25,
+            time_limit: 60.0,
+            views: 2,
+            planner: PlannerConfig {
+                unknown: UnknownPolicy::Cost(2.0),
+                ..PlannerConfig::default()
+            },
+            prior_radius: 2.0,
+            look_ahead: 3.0,
+            replan_every: 8,
+            region_margin: 6.0,
+            altitude: (1.5, 6.0),
+            distance: (8.0, 20.0),
+            surface_margin: 0.5,
+        }
+    }
+}
+
+impl FlyConfig {
+    /// Checks every value.
+    pub fn validate(self) -> Result<Self> {
+        let positive = |name: &'static str, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    expected: "a finite value > 0",
+                })
+            }
+        };
+        positive("resolution", self.resolution)?;
+        positive("speed", self.speed)?;
+        positive("frame interval", self.frame_interval)?;
+        positive("time limit", self.time_limit)?;
+        positive("prior radius", self.prior_radius)?;
+        positive("look-ahead", self.look_ahead)?;
+        positive("region margin", self.region_margin)?;
+        if !(self.surface_margin.is_finite() && self.surface_margin >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "surface margin",
+                value: self.surface_margin,
+                expected: "a finite distance >= 0 m",
+            });
+        }
+        for (name, (lo, hi)) in [("altitude", self.altitude), ("distance", self.distance)] {
+            if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: lo,
+                    expected: "a range 0 <= low < high, finite",
+                });
+            }
+        }
+        if !(2..=17).contains(&self.views) {
+            return Err(Error::InvalidParameter {
+                name: "views",
+                value: self.views as f64,
+                expected: "2 to 17 camera views per depth image",
+            });
+        }
+        if self.replan_every == 0 {
+            return Err(Error::InvalidParameter {
+                name: "replan every",
+                value: 0.0,
+                expected: "at least 1 frame",
+            });
+        }
+        self.planner.validate()?;
+        Ok(self)
+    }
+
+    /// Metres flown per frame.
+    pub fn step(&self) -> f64 {
+        self.speed * self.frame_interval
+    }
+}

@@ -1,0 +1,485 @@
+//! One closed-loop flight: the vehicle plans through what its map knows, flies a little, takes
+//! a picture, estimates depth from its own motion, updates the map and replans.
+
+use std::time::Instant;
+
+use nalgebra::{Point3, Vector3};
+use serde::Serialize;
+
+use super::config::FlyConfig;
+use super::goals::{Goal, planning_region};
+use crate::depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
+use crate::error::Result;
+use crate::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
+use crate::map::{AnyMap, VoxelMap};
+use crate::plan::{CostField, PlanError, PlanningRegion, is_blocked, plan_in_field};
+use crate::sim::render;
+use crate::sim::scenario::Scenario;
+use crate::sim::trajectory::look_at;
+use crate::storage::VoxelKey;
+
+/// How a flight ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ending {
+    /// Within [`REACHED_VOXELS`] voxel edges of the goal.
+    Reached,
+    /// The vehicle's swept ball met the true scene; the flight stopped there.
+    Collided,
+    /// The time limit passed.
+    TimeLimit,
+    /// The map offered no path (not even towards the goal) for [`STALL_FRAMES`] frames in a
+    /// row.
+    NoPath,
+}
+
+/// A flight has reached its goal within this many voxel edges of it (`√3`: in the goal's
+/// voxel or one that touches it).
+pub const REACHED_VOXELS: f64 = 1.732_050_807_568_877_2;
+
+/// Frames in a row without a path after which a flight gives up.
+pub const STALL_FRAMES: usize = 12;
+
+/// Milliseconds each part of one cycle took.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CycleTimes {
+    /// Rendering the camera's image (the simulator's part, not the vehicle's).
+    pub render_ms: f64,
+    /// The depth stage on the latest views.
+    pub depth_ms: f64,
+    /// Integrating the depth image into the map.
+    pub integrate_ms: f64,
+    /// Checking the current path against the map and, when it is no longer valid (or every
+    /// [`FlyConfig::replan_every`] frames), building the cost field and planning again.
+    pub update_replan_ms: f64,
+    /// A full rebuild of the cost field over the planning region, timed on every tenth cycle
+    /// only (for comparison); `None` on the others.
+    pub full_rebuild_ms: Option<f64>,
+}
+
+/// What one flight did.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FlightLog {
+    /// How it ended.
+    pub ending: Ending,
+    /// Positions of the vehicle, the start first, one per frame it moved.
+    pub trajectory: Vec<Point3<f64>>,
+    /// Length flown, metres.
+    pub length: f64,
+    /// Flight time, seconds (frames × frame interval).
+    pub seconds: f64,
+    /// Camera frames taken.
+    pub frames: usize,
+    /// Depth images integrated.
+    pub depth_images: usize,
+    /// Pairs the depth stage refused (too short a baseline, no overlap, ...).
+    pub depth_refused: usize,
+    /// Times the cost field was built and a path planned.
+    pub replans: usize,
+    /// Per-cycle times.
+    pub cycles: Vec<CycleTimes>,
+}
+
+/// The prior map: what the vehicle knows of its surroundings before take-off. Six true depth
+/// images from the start (four level directions, up and down), cut at the prior radius: the
+/// surfaces within it and the free space in front of them, with full confidence.
+pub fn integrate_prior(
+    scenario: &Scenario,
+    map: &mut AnyMap,
+    start: &Point3<f64>,
+    config: &FlyConfig,
+) -> Result<()> {
+    let directions = [
+        Vector3::x(),
+        Vector3::y(),
+        -Vector3::x(),
+        -Vector3::y(),
+        Vector3::new(0.01, 0.0, 1.0),
+        Vector3::new(0.01, 0.0, -1.0),
+    ];
+    let options = IntegrationOptions {
+        max_range: Some(config.prior_radius),
+    };
+    for direction in directions {
+        let pose = look_at(*start, direction);
+        let k = scenario.intrinsics;
+        let view = render(&scenario.scene, &k, &pose, 0, scenario.max_range * 4.0);
+        // Sky: far away, so that the ray clears free space up to the prior radius.
+        let far = (scenario.max_range * 4.0) as f32;
+        let depth: Vec<f32> = view
+            .depth
+            .iter()
+            .map(|z| if z.is_finite() { *z } else { far })
+            .collect();
+        let image =
+            IntervalDepthImage::from_depth(view.width, view.height, &depth, |z| (z, z, 1.0))?;
+        map.as_map_mut()
+            .integrate_depth(&DepthFrame::new(k, pose, image)?, &options)?;
+    }
+    Ok(())
+}
+
+/// Flies from `goal.start` to `goal.goal` with `map` (which holds what the vehicle knew before;
+/// [`integrate_prior`] gives it its surroundings), seeing the scene through the scenario's
+/// camera. Deterministic for `seed`.
+///
+/// Every cycle: the camera looks [`FlyConfig::look_ahead`] metres ahead along the current path
+/// (level; the yaw policy), renders, and the depth stage matches this frame against the
+/// previous ones (sideways pairs rectified, pairs along the view by plane sweep: the one stereo
+/// decision of [`ViewWindow`]); the depth image goes into the map; the current path is kept
+/// while every voxel along it stays traversable and fewer than [`FlyConfig::replan_every`]
+/// frames have passed, otherwise the cost field is rebuilt and A* plans again from the current
+/// position; then the vehicle advances `speed × frame_interval` along the path, and the true
+/// scene checks the step with the vehicle's swept ball.
+pub fn fly_goal(
+    scenario: &Scenario,
+    goal: &Goal,
+    map: &mut AnyMap,
+    config: &FlyConfig,
+    seed: u64,
+) -> Result<FlightLog> {
+    let config = config.validate()?;
+    let resolution = map.as_map().resolution();
+    let region = planning_region(&resolution, &goal.start, &goal.goal, &config)?;
+    let goal_key = resolution.key_of(&goal.goal)?;
+    let params = DepthParams {
+        depth_range: Some((0.5, scenario.max_range)),
+        forward_motion: ForwardMotion::PlaneSweep,
+        ..DepthParams::default()
+    };
+    let options = IntegrationOptions {
+        max_range: Some(scenario.max_range),
+    };
+    let mut window = ViewWindow::new(config.views)?;
+    let step = config.step();
+    let max_frames = (config.time_limit / config.frame_interval).ceil() as usize;
+
+    let mut log = FlightLog {
+        ending: Ending::TimeLimit,
+        trajectory: vec![goal.start],
+        length: 0.0,
+        seconds: 0.0,
+        frames: 0,
+        depth_images: 0,
+        depth_refused: 0,
+        replans: 0,
+        cycles: Vec::new(),
+    };
+    let mut position = goal.start;
+    let mut heading = level(goal.goal - goal.start).unwrap_or_else(Vector3::x);
+    let mut previous: Option<Frame> = None;
+    let mut path: Option<Vec<Point3<f64>>> = None;
+    let mut since_plan = 0usize;
+    let mut stalled = 0usize;
+    for frame_index in 0..max_frames {
+        let mut times = CycleTimes::default();
+        // The camera: level, towards the point ahead on the path (or the goal).
+        if let Some(ahead) = path.as_deref().map(|p| point_ahead(p, config.look_ahead))
+            && let Some(direction) = level(ahead - position)
+        {
+            heading = direction;
+        }
+        let pose = look_at(position, heading);
+        let time = frame_index as f64 * config.frame_interval;
+        let t = Instant::now();
+        let noise = seed
+            .wrapping_mul(1_000_003)
+            .wrapping_add(frame_index as u64);
+        let view = render(
+            &scenario.scene,
+            &scenario.intrinsics,
+            &pose,
+            noise,
+            scenario.max_range * 4.0,
+        );
+        let frame = view.to_frame(scenario.intrinsics, pose, time)?;
+        times.render_ms = ms(t);
+        log.frames += 1;
+
+        // Depth from this frame and the previous one, into the map.
+        if let Some(other) = previous.take() {
+            let t = Instant::now();
+            let result = window.depth(frame.clone(), other, &params);
+            times.depth_ms = ms(t);
+            match result {
+                Ok(result) => {
+                    let weight = result.reuse_weight();
+                    let mut depth = result.frame;
+                    depth.scale_confidence(weight)?;
+                    let t = Instant::now();
+                    map.as_map_mut().integrate_depth(&depth, &options)?;
+                    times.integrate_ms = ms(t);
+                    log.depth_images += 1;
+                }
+                Err(_) => log.depth_refused += 1,
+            }
+        }
+        previous = Some(frame);
+
+        // Keep the path while it is valid; otherwise plan again.
+        let t = Instant::now();
+        let keep = since_plan < config.replan_every
+            && path
+                .as_deref()
+                .is_some_and(|p| path_is_clear(map.as_map(), &region, p, &config));
+        if keep {
+            since_plan += 1;
+        } else {
+            path = replan(map.as_map(), region, &config, position, goal_key).ok();
+            log.replans += 1;
+            since_plan = 0;
+        }
+        times.update_replan_ms = ms(t);
+        if frame_index % 10 == 0 {
+            let t = Instant::now();
+            CostField::build(map.as_map(), region, config.planner)?;
+            times.full_rebuild_ms = Some(ms(t));
+        }
+        log.cycles.push(times);
+
+        // Fly.
+        let next = match path.as_mut() {
+            Some(current) if !current.is_empty() => {
+                stalled = 0;
+                advance(current, step)
+            }
+            _ => {
+                // No path: look at the goal and side-step left and right (when the map
+                // holds the step clear), so that the next frames see what blocks the way
+                // with a sideways baseline, stereo's best geometry.
+                stalled += 1;
+                if stalled >= STALL_FRAMES {
+                    log.ending = Ending::NoPath;
+                    break;
+                }
+                heading = level(goal.goal - position).unwrap_or(heading);
+                let side = heading.cross(&Vector3::z()) * if stalled % 2 == 1 { 1.0 } else { -1.0 };
+                let next = position + side * (0.6 * step);
+                if !path_is_clear(map.as_map(), &region, &[position, next], &config) {
+                    continue;
+                }
+                next
+            }
+        };
+        if scenario
+            .scene
+            .intersects_swept_ball(&position, &next, config.planner.vehicle_radius)
+        {
+            log.ending = Ending::Collided;
+            break;
+        }
+        log.length += (next - position).norm();
+        position = next;
+        log.trajectory.push(position);
+        log.seconds = (frame_index + 1) as f64 * config.frame_interval;
+        if (position - goal.goal).norm() <= REACHED_VOXELS * resolution.size() {
+            log.ending = Ending::Reached;
+            break;
+        }
+    }
+    Ok(log)
+}
+
+/// Builds the cost field over `region` and plans from `position` to the goal. When the voxel
+/// the vehicle is in cannot be entered (the map learnt that something is near), plans from the
+/// nearest traversable voxel within half a metre instead.
+fn replan(
+    map: &dyn VoxelMap,
+    region: PlanningRegion,
+    config: &FlyConfig,
+    position: Point3<f64>,
+    goal: VoxelKey,
+) -> std::result::Result<Vec<Point3<f64>>, PlanError> {
+    let resolution = map.resolution();
+    let field = CostField::build(map, region, config.planner)?;
+    let here = resolution.key_of(&position)?;
+    let start = match region.index_of(here) {
+        Some(index) if !field.is_traversable(index) => {
+            let reach = (0.5 / resolution.size()).ceil() as i32;
+            let mut best: Option<(i32, VoxelKey)> = None;
+            for dz in -reach..=reach {
+                for dy in -reach..=reach {
+                    for dx in -reach..=reach {
+                        let key = VoxelKey::new(here.x + dx, here.y + dy, here.z + dz);
+                        let d2 = dx * dx + dy * dy + dz * dz;
+                        if best.is_none_or(|(b, _)| d2 < b)
+                            && region
+                                .index_of(key)
+                                .is_some_and(|i| field.is_traversable(i))
+                        {
+                            best = Some((d2, key));
+                        }
+                    }
+                }
+            }
+            best.map_or(here, |(_, key)| key)
+        }
+        _ => here,
+    };
+    let mut path = match plan_in_field(&field, start, goal) {
+        // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
+        // it (the known-safe frontier towards the goal), see more, and plan again there.
+        Err(PlanError::GoalUnsafe(_) | PlanError::Disconnected { .. }) => {
+            let target = nearest_reachable(&field, start, goal)
+                .ok_or(PlanError::Disconnected { expanded: 0 })?;
+            if resolution.center(target) == resolution.center(start) {
+                return Err(PlanError::Disconnected { expanded: 0 });
+            }
+            plan_in_field(&field, start, target)?
+        }
+        other => other?,
+    };
+    // The path starts where the vehicle is, not at its voxel's centre.
+    if let Some(first) = path.waypoints.first_mut() {
+        *first = position;
+    }
+    Ok(path.waypoints)
+}
+
+/// The traversable voxel connected to `start` (through the field's 26-neighbourhood) nearest
+/// to `goal`, ties to the lowest index; `None` when `start` is not traversable.
+fn nearest_reachable(field: &CostField, start: VoxelKey, goal: VoxelKey) -> Option<VoxelKey> {
+    let region = field.region();
+    let first = region
+        .index_of(start)
+        .filter(|&i| field.is_traversable(i))?;
+    let mut seen = vec![false; region.len()];
+    let mut queue = std::collections::VecDeque::from([first]);
+    seen[first] = true;
+    let distance = |key: VoxelKey| {
+        let d = [key.x - goal.x, key.y - goal.y, key.z - goal.z].map(i64::from);
+        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    };
+    let mut best = (distance(start), first);
+    while let Some(index) = queue.pop_front() {
+        let key = region.key_at(index);
+        let d = distance(key);
+        if d < best.0 || (d == best.0 && index < best.1) {
+            best = (d, index);
+        }
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let next = VoxelKey::new(key.x + dx, key.y + dy, key.z + dz);
+                    if let Some(n) = region.index_of(next)
+                        && !seen[n]
+                        && field.is_traversable(n)
+                    {
+                        seen[n] = true;
+                        queue.push_back(n);
+                    }
+                }
+            }
+        }
+    }
+    Some(region.key_at(best.1))
+}
+
+/// Whether every voxel within the vehicle's required clearance of the path (sampled every half
+/// voxel) lies in the region and is not blocked in `map`.
+fn path_is_clear(
+    map: &dyn VoxelMap,
+    region: &PlanningRegion,
+    path: &[Point3<f64>],
+    config: &FlyConfig,
+) -> bool {
+    let resolution = map.resolution();
+    let size = resolution.size();
+    let required = config.planner.vehicle_radius + 3f64.sqrt() * size;
+    let reach = (required / size).ceil() as i32;
+    let mut checked = rustc_hash::FxHashSet::default();
+    let mut clear = |key: VoxelKey| {
+        if !checked.insert(key) {
+            return true;
+        }
+        region.index_of(key).is_some() && {
+            let m = map.measures_at(key);
+            !is_blocked(m.class, m.safety, &config.planner)
+        }
+    };
+    for pair in path.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let samples = ((b - a).norm() / (0.5 * size)).ceil().max(1.0) as usize;
+        for i in 0..=samples {
+            let p = a + (b - a) * (i as f64 / samples as f64);
+            let Ok(centre) = resolution.key_of(&p) else {
+                return false;
+            };
+            for dz in -reach..=reach {
+                for dy in -reach..=reach {
+                    for dx in -reach..=reach {
+                        let d2 = f64::from(dx * dx + dy * dy + dz * dz) * size * size;
+                        let key = VoxelKey::new(centre.x + dx, centre.y + dy, centre.z + dz);
+                        if d2 < required * required && !clear(key) {
+                            return false;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Moves `step` metres along `path` (its first point is the vehicle) and returns the new
+/// position; the path loses the waypoints passed and starts at the new position.
+fn advance(path: &mut Vec<Point3<f64>>, step: f64) -> Point3<f64> {
+    let mut left = step;
+    while path.len() >= 2 {
+        let (a, b) = (path[0], path[1]);
+        let leg = (b - a).norm();
+        if leg > left {
+            let p = a + (b - a) * (left / leg);
+            path[0] = p;
+            return p;
+        }
+        left -= leg;
+        path.remove(0);
+    }
+    path.first().copied().unwrap_or(Point3::origin())
+}
+
+/// The point `distance` metres along `path` (its end when the path is shorter; paths from the
+/// planner are never empty).
+fn point_ahead(path: &[Point3<f64>], distance: f64) -> Point3<f64> {
+    let mut left = distance;
+    for pair in path.windows(2) {
+        let leg = (pair[1] - pair[0]).norm();
+        if leg >= left {
+            return pair[0] + (pair[1] - pair[0]) * (left / leg.max(1e-12));
+        }
+        left -= leg;
+    }
+    path.last().copied().unwrap_or(Point3::origin())
+}
+
+/// The horizontal part of `v`, normalised; `None` when it is (nearly) vertical.
+fn level(v: Vector3<f64>) -> Option<Vector3<f64>> {
+    Vector3::new(v.x, v.y, 0.0).try_normalize(1e-6)
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn advancing_follows_the_polyline() {
+        let mut path = vec![
+            Point3::new(0.0, 0.0, 1.0),
+            Point3::new(1.0, 0.0, 1.0),
+            Point3::new(1.0, 2.0, 1.0),
+        ];
+        let p = advance(&mut path, 0.5);
+        assert_eq!(p, Point3::new(0.5, 0.0, 1.0));
+        let p = advance(&mut path, 1.0);
+        assert!((p - Point3::new(1.0, 0.5, 1.0)).norm() < 1e-12);
+        assert_eq!(path.len(), 2);
+        let p = advance(&mut path, 5.0);
+        assert_eq!(p, Point3::new(1.0, 2.0, 1.0));
+        assert_eq!(point_ahead(&[Point3::origin()], 3.0), Point3::origin());
+    }
+}

@@ -1,0 +1,153 @@
+//! Closed-loop flights: deterministic for a seed, stopped and counted at a collision, and the
+//! `fly` command as a user runs it.
+
+mod common;
+
+use common::{fuzzyvox, json};
+use fuzzyvox::fly::{Ending, FlyConfig, FlyModel, Goal, fly_all, fly_goal, integrate_prior};
+use fuzzyvox::sim::scenario::{self, Scenario};
+use fuzzyvox::sim::{Scene, SurfaceKind};
+use nalgebra::{Point3, Vector3};
+
+/// The flight logs without their timings, which differ from run to run.
+fn strip_times(mut logs: Vec<fuzzyvox::fly::FlightLog>) -> Vec<fuzzyvox::fly::FlightLog> {
+    for log in &mut logs {
+        log.cycles.clear();
+    }
+    logs
+}
+
+#[test]
+fn a_flight_is_the_same_for_the_same_seed() {
+    let wall = scenario::wall().unwrap();
+    let goal = Goal {
+        start: Point3::new(-5.9, -12.3, 2.7),
+        goal: Point3::new(3.7, -15.3, 4.7),
+        truth_length: 10.25,
+    };
+    let config = FlyConfig::default();
+    let run = || {
+        let flights = fly_all(
+            &wall,
+            &[goal],
+            &[FlyModel::Fuzzy],
+            &config,
+            3,
+            false,
+            &mut |_, _| {},
+        )
+        .unwrap();
+        strip_times(flights.into_iter().next().unwrap().flights)
+    };
+    let (a, b) = (run(), run());
+    assert_eq!(a, b);
+    let flight = &a[0];
+    assert!(flight.frames > 5 && flight.depth_images > 0, "{flight:?}");
+    assert_eq!(flight.trajectory[0], goal.start);
+}
+
+/// A 10 × 10 m plate 2.5 m under the start, which a level camera never sees (it lies below the
+/// camera's view at every distance the plate reaches), over a goal beneath it.
+fn hidden_plate() -> Scenario {
+    let mut scene = Scene::new();
+    scene.add_ground(0.013, 200.0).add_box(
+        Point3::new(0.0, 0.0, 3.0),
+        Vector3::new(5.0, 5.0, 0.05),
+        0.0,
+        SurfaceKind::Building,
+    );
+    Scenario {
+        name: "plate",
+        scene,
+        intrinsics: scenario::camera().unwrap(),
+        pairs: Vec::new(),
+        phases: Vec::new(),
+        max_range: 40.0,
+        extent: [[-10.0, -10.0], [10.0, 10.0]],
+        heights: [0.3, 6.0],
+        flight_altitude: (1.0, 6.0),
+        flight_distance: (2.0, 10.0),
+    }
+}
+
+#[test]
+fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
+    let plate = hidden_plate();
+    let goal = Goal {
+        start: Point3::new(-0.9, 0.1, 5.5),
+        goal: Point3::new(1.1, 0.1, 1.1),
+        truth_length: 12.0,
+    };
+    let config = FlyConfig::default();
+    let mut map = FlyModel::LogOdds.new_map(config.resolution).unwrap();
+    integrate_prior(&plate, &mut map, &goal.start, &config).unwrap();
+    let log = fly_goal(&plate, &goal, &mut map, &config, 1).unwrap();
+    assert_eq!(log.ending, Ending::Collided, "{:?}", log.trajectory);
+    // Stopped before the step that meets the plate: every position flown is clear of it.
+    let last = log.trajectory.last().unwrap();
+    assert!(last.z > 3.0, "{last:?}");
+    assert!(plate.scene.distance_to_surface(last) >= config.planner.vehicle_radius);
+}
+
+#[test]
+fn fly_reports_every_map_as_json() {
+    let out = std::env::temp_dir().join(format!("fuzzyvox-fly-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let report = json(&fuzzyvox(&[
+        "fly",
+        "--scenario",
+        "wall",
+        "--goals",
+        "1",
+        "--model",
+        "fuzzy,logodds",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["goals"], 1);
+    for model in ["fuzzy", "logodds"] {
+        let m = &report["maps"][model];
+        let reached = m["reached"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&reached), "{model}");
+        assert!(m["collisions"].as_u64().is_some(), "{model}");
+        assert!(m["update_replan_ms"].as_f64().unwrap() >= 0.0, "{model}");
+        assert!(m["full_rebuild_ms"].as_f64().unwrap() > 0.0, "{model}");
+        assert_eq!(m["flights"].as_array().unwrap().len(), 1);
+        assert!(out.join(format!("fly-{model}-1.png")).is_file());
+    }
+    assert!(report["maps"]["alpha"].is_null());
+    let written: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("fly.json")).unwrap()).unwrap();
+    assert_eq!(
+        written["maps"]["fuzzy"]["reached"],
+        report["maps"]["fuzzy"]["reached"]
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+
+    // Bad arguments are refused with a reason.
+    for (args, reason) in [
+        (
+            &["fly", "--scenario", "wall", "--goals", "0"][..],
+            "--goals",
+        ),
+        (
+            &[
+                "fly",
+                "--scenario",
+                "wall",
+                "--unknown",
+                "forbid",
+                "--unknown-cost",
+                "3",
+            ][..],
+            "--unknown-cost",
+        ),
+        (&["fly", "--scenario", "nowhere"][..], "nowhere"),
+    ] {
+        let run = fuzzyvox(args);
+        assert!(!run.status.success(), "{args:?}");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(stderr.contains(reason), "{args:?}: {stderr}");
+    }
+}
