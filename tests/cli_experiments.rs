@@ -217,6 +217,19 @@ fn demo_writes_the_report_maps_and_figures() {
             }
         }
     }
+    // A short closed-loop flight per scenario, every map flying its own.
+    for scenario in ["wall", "random"] {
+        let closed = &metrics[scenario]["closed_loop"];
+        assert_eq!(closed["goals"], 1, "{scenario}");
+        for map in ["logodds", "alpha", "fuzzy"] {
+            let m = &closed["maps"][map];
+            assert!(m["reached"].as_f64().is_some(), "{scenario}/{map}");
+            assert!(m["collisions"].as_u64().is_some(), "{scenario}/{map}");
+            let figure = out.join(format!("{scenario}-fly-{map}-1.png"));
+            assert!(figure.is_file(), "missing {}", figure.display());
+        }
+    }
+    assert!(report.contains("### Closed-loop flights"));
     // Every figure, chart and viewer page the report links exists.
     for link in report.split("](").skip(1) {
         let name = &link[..link.find(')').unwrap()];

@@ -6,6 +6,10 @@ use anyhow::Context;
 use clap::Args;
 use fuzzyvox::VoxelClass;
 use fuzzyvox::eval::{file_stem, report_html, write_experiment};
+use fuzzyvox::figure::save_png;
+use fuzzyvox::fly::{
+    FlyConfig, FlyModel, draw_goals, flight_figure, flights_json, flights_markdown, fly_all,
+};
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::io::ply::{PlyEncoding, write_ply};
 use fuzzyvox::ops::Family;
@@ -88,10 +92,48 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
                 &args.out.join(format!("{stem}.ply")),
             )?;
         }
-        all.insert(
-            scenario.name.to_string(),
-            serde_json::to_value(&output.report)?,
-        );
+        let mut metrics = serde_json::to_value(&output.report)?;
+        // A short closed-loop flight: each map flies to one goal through the scene, mapping
+        // with depth from the vehicle's own motion.
+        let fly_config = FlyConfig {
+            distance: (6.0, 10.0),
+            ..FlyConfig::default()
+        };
+        let goals = draw_goals(&scenario, &fly_config, 1, 1)?;
+        let flights = fly_all(
+            &scenario,
+            &goals,
+            &FlyModel::ALL,
+            &fly_config,
+            1,
+            true,
+            &mut |_, _| {},
+        )?;
+        let figure_name =
+            |model: &str, i: usize| format!("{}-fly-{model}-{}.png", scenario.name, i + 1);
+        for model in &flights {
+            for (i, (flight, map)) in model.flights.iter().zip(&model.maps).enumerate() {
+                let title = format!(
+                    "{} scenario, closed loop, {} map: {:?}, {:.1} m",
+                    scenario.name,
+                    model.model.name(),
+                    flight.ending,
+                    flight.length
+                );
+                save_png(
+                    &flight_figure(map.as_map(), &goals[i], flight, &title)?,
+                    &args.out.join(figure_name(model.model.name(), i)),
+                )?;
+            }
+        }
+        report.push_str(&flights_markdown(
+            scenario.name,
+            &goals,
+            &flights,
+            Some(&figure_name),
+        ));
+        metrics["closed_loop"] = flights_json(&goals, &fly_config, &flights);
+        all.insert(scenario.name.to_string(), metrics);
     }
     let _ = writeln!(
         report,

@@ -3,11 +3,9 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
-use fuzzyvox::figure::palette::{PATH_COLLIDES, PATH_OK};
-use fuzzyvox::figure::{Overlay, View, ViewColor, ViewSpec, save_png, view_figure};
-use fuzzyvox::fly::{Ending, FlyConfig, FlyModel, draw_goals, fly_all};
+use fuzzyvox::figure::save_png;
+use fuzzyvox::fly::{FlyConfig, FlyModel, draw_goals, flight_figure, flights_json, fly_all};
 use fuzzyvox::plan::UnknownPolicy;
-use serde_json::{Value, json};
 
 use super::eval::ScenarioName;
 use super::plan::Unknown;
@@ -120,74 +118,16 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
     )?;
     bar.finish_and_clear();
 
-    let mut maps = serde_json::Map::new();
-    for model in &flights {
-        let mut entry = serde_json::to_value(model.summary(&goals))?;
-        entry["flights"] = Value::Array(
-            model
-                .flights
-                .iter()
-                .map(|f| {
-                    json!({
-                        "ending": f.ending,
-                        "length_m": f.length,
-                        "seconds": f.seconds,
-                        "frames": f.frames,
-                        "depth_images": f.depth_images,
-                        "depth_refused": f.depth_refused,
-                        "replans": f.replans,
-                        "trajectory": f.trajectory.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    })
-                })
-                .collect(),
-        );
-        maps.insert(model.model.name().to_string(), entry);
-    }
-    let report = json!({
-        "scenario": scenario.name,
-        "seed": args.seed,
-        "goals": goals.len(),
-        "goal_list": goals,
-        "config": config,
-        "maps": maps,
-        "seconds": started.elapsed().as_secs_f64(),
-    });
+    let mut report = flights_json(&goals, &config, &flights);
+    report["scenario"] = scenario.name.into();
+    report["seed"] = args.seed.into();
+    report["seconds"] = started.elapsed().as_secs_f64().into();
     if let Some(out) = &args.out {
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
         let file = out.join("fly.json");
         fuzzyvox::io::write_atomic(&file, serde_json::to_string_pretty(&report)?.as_bytes())?;
         for model in &flights {
             for (i, (flight, map)) in model.flights.iter().zip(&model.maps).enumerate() {
-                let goal = &goals[i];
-                let mut spec = ViewSpec::new(View::Top, ViewColor::Height);
-                let margin = 4.0;
-                spec.window = Some([
-                    [
-                        goal.start.x.min(goal.goal.x) - margin,
-                        goal.start.x.max(goal.goal.x) + margin,
-                    ],
-                    [
-                        goal.start.y.min(goal.goal.y) - margin,
-                        goal.start.y.max(goal.goal.y) + margin,
-                    ],
-                ]);
-                spec.floor = Some(0.3);
-                let overlays = vec![
-                    Overlay {
-                        points: flight.trajectory.iter().map(|p| [p.x, p.y]).collect(),
-                        color: if flight.ending == Ending::Collided {
-                            PATH_COLLIDES
-                        } else {
-                            PATH_OK
-                        },
-                        mark_start: true,
-                    },
-                    Overlay {
-                        points: vec![[goal.goal.x, goal.goal.y], [goal.goal.x, goal.goal.y]],
-                        color: PATH_COLLIDES,
-                        mark_start: true,
-                    },
-                ];
                 let title = format!(
                     "{} scenario, {} map, flight {}: {:?}, {:.1} m",
                     scenario.name,
@@ -196,7 +136,7 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
                     flight.ending,
                     flight.length
                 );
-                let figure = view_figure(map.as_map(), &spec, &title, overlays, 1)?;
+                let figure = flight_figure(map.as_map(), &goals[i], flight, &title)?;
                 save_png(
                     &figure,
                     &out.join(format!("fly-{}-{}.png", model.model.name(), i + 1)),

@@ -7,17 +7,20 @@
 //! - [`config`]: the loop's parameters ([`FlyConfig`]);
 //! - [`goals`]: starts and goals in truly free space, and the true scene's path between them;
 //! - [`flight`]: one flight ([`fly_goal`]) and the prior map around the start;
+//! - [`report`]: the flights as JSON, figures and Markdown;
 //! - this module: every goal with every map ([`fly_all`]) and the summary per map.
 
 pub mod config;
 pub mod flight;
 pub mod goals;
+pub mod report;
 
 use serde::Serialize;
 
 pub use config::FlyConfig;
 pub use flight::{CycleTimes, Ending, FlightLog, fly_goal, integrate_prior};
 pub use goals::{Goal, draw_goals, planning_region, truth_map};
+pub use report::{flight_figure, flights_json, flights_markdown};
 
 use crate::error::{Error, Result};
 use crate::map::{
