@@ -94,7 +94,7 @@ pub struct ModelSummary {
     pub time_to_goal_s: Option<f64>,
     /// Camera frames over all flights.
     pub frames: usize,
-    /// Depth images integrated, and pairs the depth stage refused.
+    /// Depth images integrated.
     pub depth_images: usize,
     /// Pairs the depth stage refused.
     pub depth_refused: usize,
@@ -119,7 +119,7 @@ pub struct ModelSummary {
 }
 
 impl ModelFlights {
-    /// The summary over every flight; `truth_lengths` are the goals' true path lengths.
+    /// The summary over every flight; `goals` are the flights' goals, in the same order.
     pub fn summary(&self, goals: &[Goal]) -> ModelSummary {
         let reached: Vec<(&FlightLog, &Goal)> = self
             .flights
