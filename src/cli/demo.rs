@@ -6,9 +6,8 @@ use anyhow::Context;
 use clap::Args;
 use fuzzyvox::VoxelClass;
 use fuzzyvox::eval::{file_stem, report_html, write_experiment};
-use fuzzyvox::figure::save_png;
 use fuzzyvox::fly::{
-    FlyConfig, FlyModel, draw_goals, flight_figure, flights_json, flights_markdown, fly_all,
+    FlyConfig, FlyModel, draw_goals, flights_json, flights_markdown, fly_all, write_flight_figures,
 };
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::io::ply::{PlyEncoding, write_ply};
@@ -111,21 +110,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         )?;
         let figure_name =
             |model: &str, i: usize| format!("{}-fly-{model}-{}.png", scenario.name, i + 1);
-        for model in &flights {
-            for (i, (flight, map)) in model.flights.iter().zip(&model.maps).enumerate() {
-                let title = format!(
-                    "{} scenario, closed loop, {} map: {:?}, {:.1} m",
-                    scenario.name,
-                    model.model.name(),
-                    flight.ending,
-                    flight.length
-                );
-                save_png(
-                    &flight_figure(map.as_map(), &goals[i], flight, &title)?,
-                    &args.out.join(figure_name(model.model.name(), i)),
-                )?;
-            }
-        }
+        write_flight_figures(&args.out, scenario.name, &goals, &flights, &figure_name)?;
         report.push_str(&flights_markdown(
             scenario.name,
             &goals,

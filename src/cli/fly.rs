@@ -3,8 +3,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
-use fuzzyvox::figure::save_png;
-use fuzzyvox::fly::{FlyConfig, FlyModel, draw_goals, flight_figure, flights_json, fly_all};
+use fuzzyvox::fly::{FlyConfig, FlyModel, draw_goals, flights_json, fly_all, write_flight_figures};
 use fuzzyvox::plan::UnknownPolicy;
 
 use super::eval::ScenarioName;
@@ -126,23 +125,9 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
         let file = out.join("fly.json");
         fuzzyvox::io::write_atomic(&file, serde_json::to_string_pretty(&report)?.as_bytes())?;
-        for model in &flights {
-            for (i, (flight, map)) in model.flights.iter().zip(&model.maps).enumerate() {
-                let title = format!(
-                    "{} scenario, {} map, flight {}: {:?}, {:.1} m",
-                    scenario.name,
-                    model.model.name(),
-                    i + 1,
-                    flight.ending,
-                    flight.length
-                );
-                let figure = flight_figure(map.as_map(), &goals[i], flight, &title)?;
-                save_png(
-                    &figure,
-                    &out.join(format!("fly-{}-{}.png", model.model.name(), i + 1)),
-                )?;
-            }
-        }
+        write_flight_figures(out, scenario.name, &goals, &flights, &|model, i| {
+            format!("fly-{model}-{}.png", i + 1)
+        })?;
     }
     if args.json {
         return super::print_json(&report);

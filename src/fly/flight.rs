@@ -43,8 +43,6 @@ pub const STALL_FRAMES: usize = 12;
 /// Milliseconds each part of one cycle took.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct CycleTimes {
-    /// Rendering the camera's image (the simulator's part, not the vehicle's).
-    pub render_ms: f64,
     /// The depth stage on the latest views.
     pub depth_ms: f64,
     /// Integrating the depth image into the map.
@@ -181,7 +179,6 @@ pub fn fly_goal(
         }
         let pose = look_at(position, heading);
         let time = frame_index as f64 * config.frame_interval;
-        let t = Instant::now();
         let noise = seed
             .wrapping_mul(1_000_003)
             .wrapping_add(frame_index as u64);
@@ -193,7 +190,6 @@ pub fn fly_goal(
             scenario.max_range * 4.0,
         );
         let frame = view.to_frame(scenario.intrinsics, pose, time)?;
-        times.render_ms = ms(t);
         log.frames += 1;
 
         // Depth from this frame and the previous one, into the map.

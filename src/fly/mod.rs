@@ -20,7 +20,7 @@ use serde::Serialize;
 pub use config::FlyConfig;
 pub use flight::{CycleTimes, Ending, FlightLog, fly_goal, integrate_prior};
 pub use goals::{Goal, draw_goals, planning_region, truth_map};
-pub use report::{flight_figure, flights_json, flights_markdown};
+pub use report::{flight_figure, flights_json, flights_markdown, write_flight_figures};
 
 use crate::error::{Error, Result};
 use crate::map::{

@@ -2,6 +2,7 @@
 //! demo's report).
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use image::RgbImage;
 use serde_json::{Value, json};
@@ -11,7 +12,7 @@ use super::goals::Goal;
 use super::{FlyConfig, ModelFlights};
 use crate::error::Result;
 use crate::figure::palette::{PATH_COLLIDES, PATH_OK};
-use crate::figure::{Overlay, View, ViewColor, ViewSpec, view_figure};
+use crate::figure::{Overlay, View, ViewColor, ViewSpec, save_png, view_figure};
 use crate::map::VoxelMap;
 
 /// The report of a run: `goals`, `goal_list`, `config` and `maps.<model>` (the model's
@@ -89,6 +90,33 @@ pub fn flight_figure(
 
 /// Names the figure of a model's flight (model name, goal index).
 pub type FigureName<'a> = &'a dyn Fn(&str, usize) -> String;
+
+/// Writes [`flight_figure`] of every flight whose final map was kept into `dir`, named by
+/// `name`, titled with `scenario`, the map and how the flight ended.
+pub fn write_flight_figures(
+    dir: &Path,
+    scenario: &str,
+    goals: &[Goal],
+    flights: &[ModelFlights],
+    name: FigureName,
+) -> Result<()> {
+    for model in flights {
+        for (i, (flight, map)) in model.flights.iter().zip(&model.maps).enumerate() {
+            let title = format!(
+                "{scenario} scenario, {} map, flight {}: {:?}, {:.1} m",
+                model.model.name(),
+                i + 1,
+                flight.ending,
+                flight.length
+            );
+            save_png(
+                &flight_figure(map.as_map(), &goals[i], flight, &title)?,
+                &dir.join(name(model.model.name(), i)),
+            )?;
+        }
+    }
+    Ok(())
+}
 
 /// A Markdown section on the flights of a scenario: a table per map and the figures named by
 /// `figure(model, goal index)` when given.
