@@ -75,7 +75,7 @@ fn the_page_opens_in_a_browser_draws_the_map_and_toggles_classes() {
     let colors = browser.check_viewer_page(&page, "", &shot);
     assert!(colors >= 20, "the screenshot has only {colors} colours");
 
-    // Hiding the occupied voxels changes the picture; hiding everything leaves a plainer one.
+    // Hiding the occupied voxels, or colouring by height, changes the picture.
     let hidden = dir.join("hidden.png");
     browser.screenshot(&page, "#hide=occupied", (1000, 700), &hidden);
     let changed = changed_fraction(&shot, &hidden);
