@@ -19,6 +19,15 @@ pub struct FlyConfig {
     pub time_limit: f64,
     /// Camera views per depth image (2: the current and the previous frame). Default 2.
     pub views: usize,
+    /// Nearest depth the depth stage looks for, metres. A plane sweep's planes, and so its
+    /// time, grow with `1 / min_depth`; at the default speed a surface nearer than 1 m was
+    /// in view from farther away two frames before. Default 1.
+    pub min_depth: f64,
+    /// Depth images are integrated up to this distance from the camera, metres (the scene's
+    /// own range when that is shorter). With a baseline of one step, depth beyond it is too
+    /// uncertain to matter, and the integration's time grows with the cube of the range.
+    /// Default 20.
+    pub map_range: f64,
     /// Planner settings; the vehicle radius is also the radius of the collision check against
     /// the true scene. Default: the planner's defaults with unknown space allowed at a cost of
     /// 2 per metre (goals lie in space nobody has seen yet).
@@ -53,6 +62,8 @@ impl Default for FlyConfig {
             frame_interval: 0.25,
             time_limit: 60.0,
             views: 2,
+            min_depth: 1.0,
+            map_range: 20.0,
             planner: PlannerConfig {
                 unknown: UnknownPolicy::Cost(2.0),
                 ..PlannerConfig::default()
@@ -89,6 +100,8 @@ impl FlyConfig {
         positive("prior radius", self.prior_radius)?;
         positive("look-ahead", self.look_ahead)?;
         positive("region margin", self.region_margin)?;
+        positive("minimum depth", self.min_depth)?;
+        positive("map range", self.map_range)?;
         if !(self.surface_margin.is_finite() && self.surface_margin >= 0.0) {
             return Err(Error::InvalidParameter {
                 name: "surface margin",

@@ -11,8 +11,8 @@ use super::goals::{Goal, planning_region};
 use crate::depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
-use crate::map::{AnyMap, VoxelMap};
-use crate::plan::{CostField, PlanError, PlanningRegion, is_blocked, plan_in_field};
+use crate::map::AnyMap;
+use crate::plan::{CostField, PlanError, Planner, plan_in_field};
 use crate::sim::render;
 use crate::sim::scenario::Scenario;
 use crate::sim::trajectory::look_at;
@@ -47,8 +47,9 @@ pub struct CycleTimes {
     pub depth_ms: f64,
     /// Integrating the depth image into the map.
     pub integrate_ms: f64,
-    /// Checking the current path against the map and, when it is no longer valid (or every
-    /// [`FlyConfig::replan_every`] frames), building the cost field and planning again.
+    /// Updating the cost field from the blocks the integration changed, checking the current
+    /// path against it and, when the path is no longer clear (or every
+    /// [`FlyConfig::replan_every`] frames), planning again.
     pub update_replan_ms: f64,
     /// A full rebuild of the cost field over the planning region, timed on every tenth cycle
     /// only (for comparison); `None` on the others.
@@ -119,16 +120,7 @@ pub fn integrate_prior(
 
 /// Flies from `goal.start` to `goal.goal` with `map` (which holds what the vehicle knew before;
 /// [`integrate_prior`] gives it its surroundings), seeing the scene through the scenario's
-/// camera. Deterministic for `seed`.
-///
-/// Every cycle: the camera looks [`FlyConfig::look_ahead`] metres ahead along the current path
-/// (level; the yaw policy), renders, and the depth stage matches this frame against the
-/// previous ones (sideways pairs rectified, pairs along the view by plane sweep: the one stereo
-/// decision of [`ViewWindow`]); the depth image goes into the map; the current path is kept
-/// while every voxel along it stays traversable and fewer than [`FlyConfig::replan_every`]
-/// frames have passed, otherwise the cost field is rebuilt and A* plans again from the current
-/// position; then the vehicle advances `speed × frame_interval` along the path, and the true
-/// scene checks the step with the vehicle's swept ball.
+/// camera. Deterministic for `seed`. Runs [`Flight::cycle`] until the flight ends.
 pub fn fly_goal(
     scenario: &Scenario,
     goal: &Goal,
@@ -136,52 +128,171 @@ pub fn fly_goal(
     config: &FlyConfig,
     seed: u64,
 ) -> Result<FlightLog> {
-    let config = config.validate()?;
-    let resolution = map.as_map().resolution();
-    let region = planning_region(&resolution, &goal.start, &goal.goal, &config)?;
-    let goal_key = resolution.key_of(&goal.goal)?;
-    let params = DepthParams {
-        depth_range: Some((0.5, scenario.max_range)),
-        forward_motion: ForwardMotion::PlaneSweep,
-        ..DepthParams::default()
-    };
-    let options = IntegrationOptions {
-        max_range: Some(scenario.max_range),
-    };
-    let mut window = ViewWindow::new(config.views)?;
-    let step = config.step();
-    let max_frames = (config.time_limit / config.frame_interval).ceil() as usize;
+    let mut flight = Flight::new(scenario, goal, map, config, seed)?;
+    while flight.ending().is_none() {
+        flight.cycle(map)?;
+    }
+    Ok(flight.into_log())
+}
 
-    let mut log = FlightLog {
-        ending: Ending::TimeLimit,
-        trajectory: vec![goal.start],
-        length: 0.0,
-        seconds: 0.0,
-        frames: 0,
-        depth_images: 0,
-        depth_refused: 0,
-        replans: 0,
-        cycles: Vec::new(),
-    };
-    let mut position = goal.start;
-    let mut heading = level(goal.goal - goal.start).unwrap_or_else(Vector3::x);
-    let mut previous: Option<Frame> = None;
-    let mut path: Option<Vec<Point3<f64>>> = None;
-    let mut since_plan = 0usize;
-    let mut stalled = 0usize;
-    for frame_index in 0..max_frames {
-        let mut times = CycleTimes::default();
-        // The camera: level, towards the point ahead on the path (or the goal).
-        if let Some(ahead) = path.as_deref().map(|p| point_ahead(p, config.look_ahead))
-            && let Some(direction) = level(ahead - position)
-        {
-            heading = direction;
+/// One closed-loop flight in progress: the vehicle's state between cycles.
+///
+/// Every [`cycle`](Flight::cycle): the camera looks [`FlyConfig::look_ahead`] metres ahead
+/// along the current path (level; the yaw policy) and renders ([`Flight::render`]); then the
+/// vehicle's own work ([`Flight::see`]): the depth stage matches this frame against the
+/// previous ones (sideways pairs rectified, pairs along the view by plane sweep: the one
+/// stereo decision of [`ViewWindow`]), the depth image goes into the map, the [`Planner`]
+/// updates its cost field around the blocks the map changed, the current path is kept while
+/// it stays clear and fewer than [`FlyConfig::replan_every`] frames have passed, otherwise A*
+/// plans again from the current position; then the vehicle advances `speed × frame_interval`
+/// along the path, and the true scene checks the step with the vehicle's swept ball.
+#[derive(Clone)]
+pub struct Flight<'a> {
+    scenario: &'a Scenario,
+    goal: Goal,
+    goal_key: VoxelKey,
+    config: FlyConfig,
+    seed: u64,
+    params: DepthParams,
+    options: IntegrationOptions,
+    planner: Planner,
+    window: ViewWindow,
+    previous: Option<Frame>,
+    path: Option<Vec<Point3<f64>>>,
+    position: Point3<f64>,
+    heading: Vector3<f64>,
+    since_plan: usize,
+    stalled: usize,
+    frame_index: usize,
+    max_frames: usize,
+    ending: Option<Ending>,
+    log: FlightLog,
+}
+
+impl<'a> Flight<'a> {
+    /// A vehicle at `goal.start` with `map` (its prior knowledge), about to take its first
+    /// picture.
+    pub fn new(
+        scenario: &'a Scenario,
+        goal: &Goal,
+        map: &AnyMap,
+        config: &FlyConfig,
+        seed: u64,
+    ) -> Result<Self> {
+        let config = config.validate()?;
+        let resolution = map.as_map().resolution();
+        let region = planning_region(&resolution, &goal.start, &goal.goal, &config)?;
+        Ok(Self {
+            scenario,
+            goal: *goal,
+            goal_key: resolution.key_of(&goal.goal)?,
+            config,
+            seed,
+            params: DepthParams {
+                depth_range: Some((config.min_depth, scenario.max_range)),
+                forward_motion: ForwardMotion::PlaneSweep,
+                ..DepthParams::default()
+            },
+            options: IntegrationOptions {
+                max_range: Some(scenario.max_range.min(config.map_range)),
+            },
+            planner: Planner::new(map.as_map(), region, config.planner)?,
+            window: ViewWindow::new(config.views)?,
+            previous: None,
+            path: None,
+            position: goal.start,
+            heading: level(goal.goal - goal.start).unwrap_or_else(Vector3::x),
+            since_plan: 0,
+            stalled: 0,
+            frame_index: 0,
+            max_frames: (config.time_limit / config.frame_interval).ceil() as usize,
+            ending: None,
+            log: FlightLog {
+                ending: Ending::TimeLimit,
+                trajectory: vec![goal.start],
+                length: 0.0,
+                seconds: 0.0,
+                frames: 0,
+                depth_images: 0,
+                depth_refused: 0,
+                replans: 0,
+                cycles: Vec::new(),
+            },
+        })
+    }
+
+    /// How the flight ended, or `None` while it goes on.
+    pub fn ending(&self) -> Option<Ending> {
+        self.ending
+    }
+
+    /// Where the vehicle is.
+    pub fn position(&self) -> Point3<f64> {
+        self.position
+    }
+
+    /// The planner and its current cost field.
+    pub fn planner(&self) -> &Planner {
+        &self.planner
+    }
+
+    /// The log so far.
+    pub fn log(&self) -> &FlightLog {
+        &self.log
+    }
+
+    /// The finished flight's log.
+    pub fn into_log(self) -> FlightLog {
+        self.log
+    }
+
+    /// One cycle: [`render`](Flight::render), [`see`](Flight::see) and
+    /// [`fly`](Flight::fly). Does nothing once the flight has ended.
+    pub fn cycle(&mut self, map: &mut AnyMap) -> Result<()> {
+        if self.ending.is_some() {
+            return Ok(());
         }
-        let pose = look_at(position, heading);
-        let time = frame_index as f64 * config.frame_interval;
-        let noise = seed
+        if self.frame_index >= self.max_frames {
+            self.ending = Some(Ending::TimeLimit);
+            self.log.ending = Ending::TimeLimit;
+            return Ok(());
+        }
+        let frame = self.render()?;
+        self.see(frame, map)?;
+        if self.frame_index.is_multiple_of(10) {
+            let t = Instant::now();
+            CostField::build(
+                map.as_map(),
+                *self.planner.field().region(),
+                self.config.planner,
+            )?;
+            let rebuild = ms(t);
+            if let Some(last) = self.log.cycles.last_mut() {
+                last.full_rebuild_ms = Some(rebuild);
+            }
+        }
+        self.fly(map);
+        self.frame_index += 1;
+        Ok(())
+    }
+
+    /// The picture the camera takes now: level, towards the point ahead on the path (or the
+    /// goal), rendered from the true scene with the frame's noise.
+    pub fn render(&mut self) -> Result<Frame> {
+        if let Some(ahead) = self
+            .path
+            .as_deref()
+            .map(|p| point_ahead(p, self.config.look_ahead))
+            && let Some(direction) = level(ahead - self.position)
+        {
+            self.heading = direction;
+        }
+        let pose = look_at(self.position, self.heading);
+        let noise = self
+            .seed
             .wrapping_mul(1_000_003)
-            .wrapping_add(frame_index as u64);
+            .wrapping_add(self.frame_index as u64);
+        let scenario = self.scenario;
         let view = render(
             &scenario.scene,
             &scenario.intrinsics,
@@ -189,13 +300,19 @@ pub fn fly_goal(
             noise,
             scenario.max_range * 4.0,
         );
-        let frame = view.to_frame(scenario.intrinsics, pose, time)?;
-        log.frames += 1;
+        let time = self.frame_index as f64 * self.config.frame_interval;
+        view.to_frame(scenario.intrinsics, pose, time)
+    }
 
-        // Depth from this frame and the previous one, into the map.
-        if let Some(other) = previous.take() {
+    /// The vehicle's own work on a new frame: depth from it and the previous frame(s) into the
+    /// map, the cost field updated from the blocks that changed, the path kept or planned
+    /// again. Returns (and logs) what each part took.
+    pub fn see(&mut self, frame: Frame, map: &mut AnyMap) -> Result<CycleTimes> {
+        let mut times = CycleTimes::default();
+        self.log.frames += 1;
+        if let Some(other) = self.previous.take() {
             let t = Instant::now();
-            let result = window.depth(frame.clone(), other, &params);
+            let result = self.window.depth(frame.clone(), other, &self.params);
             times.depth_ms = ms(t);
             match result {
                 Ok(result) => {
@@ -203,91 +320,100 @@ pub fn fly_goal(
                     let mut depth = result.frame;
                     depth.scale_confidence(weight)?;
                     let t = Instant::now();
-                    map.as_map_mut().integrate_depth(&depth, &options)?;
+                    map.as_map_mut().integrate_depth(&depth, &self.options)?;
                     times.integrate_ms = ms(t);
-                    log.depth_images += 1;
+                    self.log.depth_images += 1;
                 }
-                Err(_) => log.depth_refused += 1,
+                Err(_) => self.log.depth_refused += 1,
             }
         }
-        previous = Some(frame);
+        self.previous = Some(frame);
 
-        // Keep the path while it is valid; otherwise plan again.
+        // Update the field from what the frame changed; keep the path while it is clear,
+        // otherwise plan again.
         let t = Instant::now();
-        let keep = since_plan < config.replan_every
-            && path
+        self.planner.update(map.as_map());
+        let keep = self.since_plan < self.config.replan_every
+            && self
+                .path
                 .as_deref()
-                .is_some_and(|p| path_is_clear(map.as_map(), &region, p, &config));
+                .is_some_and(|p| self.planner.is_clear(p));
         if keep {
-            since_plan += 1;
+            self.since_plan += 1;
         } else {
-            path = replan(map.as_map(), region, &config, position, goal_key).ok();
-            log.replans += 1;
-            since_plan = 0;
+            self.path = replan(self.planner.field(), self.position, self.goal_key).ok();
+            self.log.replans += 1;
+            self.since_plan = 0;
         }
         times.update_replan_ms = ms(t);
-        if frame_index % 10 == 0 {
-            let t = Instant::now();
-            CostField::build(map.as_map(), region, config.planner)?;
-            times.full_rebuild_ms = Some(ms(t));
-        }
-        log.cycles.push(times);
+        self.log.cycles.push(times);
+        Ok(times)
+    }
 
-        // Fly.
-        let next = match path.as_mut() {
+    /// Advances along the path (or side-steps when there is none), checks the step against the
+    /// true scene, and ends the flight at a collision, at the goal or after too many frames
+    /// without a path.
+    fn fly(&mut self, map: &AnyMap) {
+        let step = self.config.step();
+        let position = self.position;
+        let next = match self.path.as_mut() {
             Some(current) if !current.is_empty() => {
-                stalled = 0;
+                self.stalled = 0;
                 advance(current, step)
             }
             _ => {
                 // No path: look at the goal and side-step left and right (when the map
                 // holds the step clear), so that the next frames see what blocks the way
                 // with a sideways baseline, stereo's best geometry.
-                stalled += 1;
-                if stalled >= STALL_FRAMES {
-                    log.ending = Ending::NoPath;
-                    break;
+                self.stalled += 1;
+                if self.stalled >= STALL_FRAMES {
+                    self.finish(Ending::NoPath);
+                    return;
                 }
-                heading = level(goal.goal - position).unwrap_or(heading);
-                let side = heading.cross(&Vector3::z()) * if stalled % 2 == 1 { 1.0 } else { -1.0 };
-                let next = position + side * (0.6 * step);
-                if !path_is_clear(map.as_map(), &region, &[position, next], &config) {
-                    continue;
+                self.heading = level(self.goal.goal - position).unwrap_or(self.heading);
+                let sign = if self.stalled % 2 == 1 { 1.0 } else { -1.0 };
+                let next = position + self.heading.cross(&Vector3::z()) * sign * (0.6 * step);
+                if !self.planner.is_clear(&[position, next]) {
+                    return;
                 }
                 next
             }
         };
-        if scenario
+        let radius = self.config.planner.vehicle_radius;
+        if self
+            .scenario
             .scene
-            .intersects_swept_ball(&position, &next, config.planner.vehicle_radius)
+            .intersects_swept_ball(&position, &next, radius)
         {
-            log.ending = Ending::Collided;
-            break;
+            self.finish(Ending::Collided);
+            return;
         }
-        log.length += (next - position).norm();
-        position = next;
-        log.trajectory.push(position);
-        log.seconds = (frame_index + 1) as f64 * config.frame_interval;
-        if (position - goal.goal).norm() <= REACHED_VOXELS * resolution.size() {
-            log.ending = Ending::Reached;
-            break;
+        self.log.length += (next - position).norm();
+        self.position = next;
+        self.log.trajectory.push(next);
+        self.log.seconds = (self.frame_index + 1) as f64 * self.config.frame_interval;
+        let reach = REACHED_VOXELS * map.as_map().resolution().size();
+        if (next - self.goal.goal).norm() <= reach {
+            self.finish(Ending::Reached);
         }
     }
-    Ok(log)
+
+    fn finish(&mut self, ending: Ending) {
+        self.ending = Some(ending);
+        self.log.ending = ending;
+    }
 }
 
-/// Builds the cost field over `region` and plans from `position` to the goal. When the voxel
-/// the vehicle is in cannot be entered (the map learnt that something is near), plans from the
-/// nearest traversable voxel within half a metre instead.
+/// Plans through `field` from `position` to the goal. When the voxel the vehicle is in cannot
+/// be entered (the map learnt that something is near), plans from the nearest traversable
+/// voxel within half a metre instead.
 fn replan(
-    map: &dyn VoxelMap,
-    region: PlanningRegion,
-    config: &FlyConfig,
+    field: &CostField,
     position: Point3<f64>,
     goal: VoxelKey,
 ) -> std::result::Result<Vec<Point3<f64>>, PlanError> {
-    let resolution = map.resolution();
-    let field = CostField::build(map, region, config.planner)?;
+    let resolution = field.resolution();
+    let region = *field.region();
     let here = resolution.key_of(&position)?;
     let start = match region.index_of(here) {
         Some(index) if !field.is_traversable(index) => {
@@ -312,16 +438,16 @@ fn replan(
         }
         _ => here,
     };
-    let mut path = match plan_in_field(&field, start, goal) {
+    let mut path = match plan_in_field(field, start, goal) {
         // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
         // it (the known-safe frontier towards the goal), see more, and plan again there.
         Err(PlanError::GoalUnsafe(_) | PlanError::Disconnected { .. }) => {
-            let target = nearest_reachable(&field, start, goal)
+            let target = nearest_reachable(field, start, goal)
                 .ok_or(PlanError::Disconnected { expanded: 0 })?;
             if resolution.center(target) == resolution.center(start) {
                 return Err(PlanError::Disconnected { expanded: 0 });
             }
-            plan_in_field(&field, start, target)?
+            plan_in_field(field, start, target)?
         }
         other => other?,
     };
@@ -369,52 +495,6 @@ fn nearest_reachable(field: &CostField, start: VoxelKey, goal: VoxelKey) -> Opti
         }
     }
     Some(region.key_at(best.1))
-}
-
-/// Whether every voxel within the vehicle's required clearance of the path (sampled every half
-/// voxel) lies in the region and is not blocked in `map`.
-fn path_is_clear(
-    map: &dyn VoxelMap,
-    region: &PlanningRegion,
-    path: &[Point3<f64>],
-    config: &FlyConfig,
-) -> bool {
-    let resolution = map.resolution();
-    let size = resolution.size();
-    let required = config.planner.vehicle_radius + 3f64.sqrt() * size;
-    let reach = (required / size).ceil() as i32;
-    let mut checked = rustc_hash::FxHashSet::default();
-    let mut clear = |key: VoxelKey| {
-        if !checked.insert(key) {
-            return true;
-        }
-        region.index_of(key).is_some() && {
-            let m = map.measures_at(key);
-            !is_blocked(m.class, m.safety, &config.planner)
-        }
-    };
-    for pair in path.windows(2) {
-        let (a, b) = (pair[0], pair[1]);
-        let samples = ((b - a).norm() / (0.5 * size)).ceil().max(1.0) as usize;
-        for i in 0..=samples {
-            let p = a + (b - a) * (i as f64 / samples as f64);
-            let Ok(centre) = resolution.key_of(&p) else {
-                return false;
-            };
-            for dz in -reach..=reach {
-                for dy in -reach..=reach {
-                    for dx in -reach..=reach {
-                        let d2 = f64::from(dx * dx + dy * dy + dz * dz) * size * size;
-                        let key = VoxelKey::new(centre.x + dx, centre.y + dy, centre.z + dz);
-                        if d2 < required * required && !clear(key) {
-                            return false;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    true
 }
 
 /// Moves `step` metres along `path` (its first point is the vehicle) and returns the new

@@ -6,7 +6,7 @@ use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
 use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, scan_levels};
 use crate::measures::{MeasureConfig, Memberships};
-use crate::storage::{Resolution, VoxelKey};
+use crate::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
 
 /// Parameters of the alpha-cut map.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -115,6 +115,10 @@ impl VoxelMap for AlphaCutMap {
         self.inner.memberships_at(key)
     }
 
+    fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
+        self.inner.block_memberships(key, out);
+    }
+
     fn counts(&self) -> VoxelCounts {
         self.inner.counts()
     }
@@ -125,6 +129,14 @@ impl VoxelMap for AlphaCutMap {
 
     fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
         self.inner.cells()
+    }
+
+    fn write_version(&self) -> Option<u64> {
+        self.inner.write_version()
+    }
+
+    fn changed_blocks_since(&self, version: u64) -> Option<Vec<BlockKey>> {
+        self.inner.changed_blocks_since(version)
     }
 }
 

@@ -10,7 +10,7 @@ use crate::integrate::{
 };
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::ops::TConorm;
-use crate::storage::{BlockGrid, KeyBox, Resolution, VoxelKey};
+use crate::storage::{BLOCK_CELLS, BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};
 
 /// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
 /// and how free (μE), each aggregated from evidence with a t-conorm `S`:
@@ -179,12 +179,27 @@ impl VoxelMap for FuzzyMap {
         self.config.resolution
     }
 
+    fn write_version(&self) -> Option<u64> {
+        Some(self.grid.version())
+    }
+
+    fn changed_blocks_since(&self, version: u64) -> Option<Vec<BlockKey>> {
+        Some(self.grid.changed_since(version))
+    }
+
     fn measure_config(&self) -> &MeasureConfig {
         &self.config.measures
     }
 
     fn memberships_at(&self, key: VoxelKey) -> Memberships {
         self.grid.cell(key).copied().unwrap_or_default()
+    }
+
+    fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
+        match self.grid.block(key) {
+            Some(block) => *out = block.cells,
+            None => out.fill(Memberships::default()),
+        }
     }
 }
 

@@ -8,7 +8,7 @@ use crate::integrate::{
     DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanLevels, ScanSets, scan_sets,
 };
 use crate::measures::{MeasureConfig, Memberships};
-use crate::storage::{Block, BlockGrid, Resolution, VoxelKey};
+use crate::storage::{BLOCK_CELLS, Block, BlockGrid, BlockKey, Resolution, VoxelKey};
 
 /// One log-odds cell: `ln(p / (1 - p))` of being occupied, NaN when never observed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -290,12 +290,31 @@ impl VoxelMap for LogOddsMap {
         self.config.resolution
     }
 
+    fn write_version(&self) -> Option<u64> {
+        Some(self.grid.version())
+    }
+
+    fn changed_blocks_since(&self, version: u64) -> Option<Vec<BlockKey>> {
+        Some(self.grid.changed_since(version))
+    }
+
     fn measure_config(&self) -> &MeasureConfig {
         &self.config.measures
     }
 
     fn memberships_at(&self, key: VoxelKey) -> Memberships {
         self.log_odds_at(key).memberships()
+    }
+
+    fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
+        match self.grid.block(key) {
+            Some(block) => {
+                for (m, cell) in out.iter_mut().zip(&block.cells) {
+                    *m = cell.memberships();
+                }
+            }
+            None => out.fill(LogOdds::default().memberships()),
+        }
     }
 
     fn counts(&self) -> VoxelCounts {

@@ -26,7 +26,7 @@ use nalgebra::Point3;
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud};
 use crate::measures::{MeasureConfig, Measures, Memberships, VoxelClass};
-use crate::storage::{Resolution, VoxelKey};
+use crate::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
 
 /// What every map answers: memberships, measures and classes per voxel, counts, memory and its
 /// observed voxels, so that planners, metrics and exporters run on any map alike: the three
@@ -44,6 +44,15 @@ pub trait VoxelMap: Send + Sync {
     /// A voxel's memberships (both 0 when nothing is known about it).
     fn memberships_at(&self, key: VoxelKey) -> Memberships;
 
+    /// The memberships of the voxels of one block (8×8×8, [`BlockKey::voxel`] order, x
+    /// fastest) into `out`; voxels nothing is known about read as zero. Maps with block
+    /// storage answer with one lookup; the default asks [`VoxelMap::memberships_at`] per voxel.
+    fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
+        for (i, m) in out.iter_mut().enumerate() {
+            *m = self.memberships_at(key.voxel(i));
+        }
+    }
+
     /// Voxel counts per class over the allocated blocks (from block summaries).
     fn counts(&self) -> VoxelCounts;
 
@@ -53,6 +62,21 @@ pub trait VoxelMap: Send + Sync {
     /// Every observed voxel (one that some evidence reached) with its memberships, in storage
     /// order.
     fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_>;
+
+    /// The map's write version, for consumers that follow its changes (see
+    /// [`VoxelMap::changed_blocks_since`]); `None` when the map does not track its writes
+    /// (read-only maps, whose voxels never change).
+    fn write_version(&self) -> Option<u64> {
+        None
+    }
+
+    /// Keys of the blocks (8×8×8 voxels, [`VoxelKey::block`]) written after `version`, in
+    /// ascending order: every voxel whose memberships changed since the map's
+    /// [`write_version`](VoxelMap::write_version) was `version` lies in one of them. `None`
+    /// when the map does not track its writes.
+    fn changed_blocks_since(&self, _version: u64) -> Option<Vec<BlockKey>> {
+        None
+    }
 
     /// A voxel's memberships at a world point (an error outside the key range).
     fn memberships_at_point(&self, point: &Point3<f64>) -> Result<Memberships> {

@@ -2,7 +2,8 @@ use serde::{Deserialize, Serialize};
 
 use super::class::{ClassThresholds, VoxelClass};
 use crate::error::Result;
-use crate::ops::{Hedge, TNorm};
+use crate::ops::numeric::unit;
+use crate::ops::{Family, Hedge, TNorm};
 
 /// A voxel's two membership degrees, each in `[0, 1]` and independent of each other.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -32,15 +33,7 @@ impl MeasureConfig {
 
     /// All measures of one voxel.
     pub fn measures(&self, m: Memberships) -> Measures {
-        let t = |a, b| self.tnorm.apply(a, b);
-        let not = |a: f32| 1.0 - a;
-        let ambiguity = t(m.occupied, m.free);
-        let indeterminacy = t(not(m.occupied), not(m.free));
-        // "Very free, and not occupied, and not ambiguous, and not unknown".
-        let safety = t(
-            Hedge::Concentration.apply(m.free),
-            t(not(m.occupied), t(not(ambiguity), not(indeterminacy))),
-        );
+        let (ambiguity, indeterminacy, safety) = self.core(m);
         Measures {
             occupied: m.occupied,
             free: m.free,
@@ -51,6 +44,38 @@ impl MeasureConfig {
             contradiction: m.occupied + m.free - 1.0,
             class: self.classify_with_ambiguity(m, ambiguity),
         }
+    }
+
+    /// A voxel's safety and class: what a planner reads, without the other measures.
+    #[inline]
+    pub fn safety_and_class(&self, m: Memberships) -> (f32, VoxelClass) {
+        let (ambiguity, _, safety) = self.core(m);
+        (safety, self.classify_with_ambiguity(m, ambiguity))
+    }
+
+    /// Ambiguity, indeterminacy and safety.
+    #[inline]
+    fn core(&self, m: Memberships) -> (f32, f32, f32) {
+        if self.tnorm.family() == Family::Minimum {
+            // The default t-norm, without the per-call dispatch (a planner reads measures of
+            // every voxel it updates): the same values, since every operand below already
+            // lies in [0, 1], where `T` is `min`.
+            let (o, f) = (unit(m.occupied), unit(m.free));
+            let ambiguity = o.min(f);
+            let indeterminacy = (1.0 - o).min(1.0 - f);
+            let safety = (f * f).min((1.0 - o).min((1.0 - ambiguity).min(1.0 - indeterminacy)));
+            return (ambiguity, indeterminacy, safety);
+        }
+        let t = |a, b| self.tnorm.apply(a, b);
+        let not = |a: f32| 1.0 - a;
+        let ambiguity = t(m.occupied, m.free);
+        let indeterminacy = t(not(m.occupied), not(m.free));
+        // "Very free, and not occupied, and not ambiguous, and not unknown".
+        let safety = t(
+            Hedge::Concentration.apply(m.free),
+            t(not(m.occupied), t(not(ambiguity), not(indeterminacy))),
+        );
+        (ambiguity, indeterminacy, safety)
     }
 
     /// The class of one voxel (see [`ClassThresholds`] for the rule).

@@ -22,6 +22,7 @@ pub enum Hedge {
 impl Hedge {
     /// Applies the hedge. The input is clamped into `[0, 1]` (NaN counts as 0);
     /// the result is in `[0, 1]`, never NaN, with 0 and 1 left unchanged.
+    #[inline]
     pub fn apply(&self, x: f32) -> f32 {
         let x = unit(x);
         match self {

@@ -36,7 +36,7 @@ mod family;
 mod frank;
 mod generator;
 mod hedge;
-mod numeric;
+pub(crate) mod numeric;
 mod tconorm;
 mod tnorm;
 

@@ -54,6 +54,7 @@ impl TNorm {
     /// Inputs are clamped into `[0, 1]` (NaN counts as 0). The result is in
     /// `[0, 1]` and never NaN. The boundary laws `T(x, 1) = x` and
     /// `T(x, 0) = 0` hold exactly, and `T(x, y) == T(y, x)` bit for bit.
+    #[inline]
     pub fn apply(&self, x: f32, y: f32) -> f32 {
         let (x, y) = (unit(x), unit(y));
         match self.family {

@@ -10,6 +10,7 @@ use super::blocker::{Blocker, ObservedExtent};
 use super::config::PlannerConfig;
 use super::cost_field::{CostField, PlanningRegion};
 use super::graph::VoxelGraph;
+use super::planner::Planner;
 use crate::error::Error;
 use crate::integrate::walk_ray;
 use crate::map::VoxelMap;
@@ -72,9 +73,9 @@ impl PlanError {
     }
 }
 
-/// Plans from `from` to `to` in any map: builds the cost field of the box around both points
-/// grown by a margin (the vehicle radius plus the preferred clearance plus 2 m), then runs
-/// [`plan_in_field`].
+/// Plans from `from` to `to` in any map, once: a [`Planner`] over the box around both points
+/// grown by a margin (the vehicle radius plus the preferred clearance plus 2 m). To plan again
+/// and again while a map grows, keep a [`Planner`] and update it instead.
 ///
 /// A start or goal in unknown space that also lies outside the map's [`ObservedExtent`] is
 /// reported as [`Blocker::OutsideObservedExtent`] rather than [`Blocker::Unknown`]: a point
@@ -91,7 +92,7 @@ pub fn plan_path(
     let goal = resolution.key_of(to)?;
     let margin = config.vehicle_radius + config.preferred_clearance + 2.0;
     let region = PlanningRegion::around(&resolution, from, to, margin)?;
-    let field = CostField::build(map, region, config)?;
+    let planner = Planner::new(map, region, config)?;
     // The extent costs a pass over the map, so it is only computed for an unknown end point.
     let off_map = |point: &Point3<f64>, key: VoxelKey| {
         ObservedExtent::of(map)
@@ -101,7 +102,7 @@ pub fn plan_path(
                 extent,
             })
     };
-    match plan_in_field(&field, start, goal) {
+    match planner.plan(start, goal) {
         Err(PlanError::StartUnsafe(Blocker::Unknown)) => {
             Err(PlanError::StartUnsafe(off_map(from, start)))
         }
@@ -225,7 +226,7 @@ pub fn plan_in_field(
 /// Calls `visit` with the dense index of every voxel the straight segment between two voxel
 /// centres passes through (both ends included), stopping early when `visit` returns false;
 /// returns false when stopped or when the segment leaves the region.
-fn segment_voxels(
+pub(super) fn segment_voxels(
     field: &CostField,
     from: VoxelKey,
     to: VoxelKey,

@@ -1,13 +1,13 @@
 use nalgebra::Point3;
-use rayon::prelude::*;
 
 use super::blocker::{Blocker, NearestBlocked};
 use super::config::{PlannerConfig, UnknownPolicy};
 use super::edt::squared_distance_transform;
+use super::field_update::{Change, block_parts, read_parts};
 use crate::error::{Error, Result};
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
-use crate::storage::{Resolution, VoxelKey};
+use crate::storage::{BlockKey, Resolution, VoxelKey};
 
 /// Largest planning region, in voxels (a guard against absurd requests: 64 Mi voxels use about
 /// 1 GiB of working memory).
@@ -103,7 +103,8 @@ impl PlanningRegion {
 ///   threshold, or when it is unknown and unknown space is forbidden. Space outside the region
 ///   counts as blocked.
 /// - **Clearance** is the exact Euclidean distance from the voxel's centre to the nearest blocked
-///   voxel centre.
+///   voxel centre, up to [`CostField::clearance_cap`] (the larger of the required and the
+///   preferred clearance; larger distances read as the cap, which changes no decision).
 /// - A voxel is **traversable** when it is not blocked and its clearance is at least the vehicle
 ///   radius plus `√3 × resolution`. That margin covers half a blocked voxel and half a step, so
 ///   every point of a path whose steps join traversable voxels (or whose straight segments only
@@ -111,17 +112,36 @@ impl PlanningRegion {
 /// - Entering a voxel costs, per metre, `1 + k (1 - S) + w max(0, 1 - clearance / preferred)`
 ///   (plus the unknown cost for unknown voxels under [`UnknownPolicy::Cost`]); a step of length
 ///   `l` between voxels costs `l` times the mean of their two rates, never less than `l`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CostField {
     region: PlanningRegion,
     resolution: Resolution,
     config: PlannerConfig,
-    traversable: Vec<bool>,
-    class: Vec<VoxelClass>,
-    safety: Vec<f32>,
-    clearance: Vec<f32>,
-    rate: Vec<f32>,
+    /// Per voxel, dense index order (x fastest). One record per voxel rather than one array
+    /// per entry: an update reads and writes a voxel's entries together, one cache line.
+    voxels: Vec<Voxel>,
     min_rate: f32,
+}
+
+/// What the field knows of one voxel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Voxel {
+    safety: f32,
+    clearance: f32,
+    /// Cost per metre (infinite when not traversable).
+    rate: f32,
+    class: VoxelClass,
+    traversable: bool,
+}
+
+impl Voxel {
+    const UNKNOWN: Self = Self {
+        safety: 0.0,
+        clearance: 0.0,
+        rate: f32::INFINITY,
+        class: VoxelClass::Unknown,
+        traversable: false,
+    };
 }
 
 impl CostField {
@@ -134,54 +154,163 @@ impl CostField {
         let config = config.validate()?;
         let resolution = map.resolution();
         let n = region.len();
-        let measures: Vec<(f32, VoxelClass)> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let m = map.measures_at(region.key_at(i));
-                (m.safety, m.class)
-            })
-            .collect();
-        let blocked: Vec<bool> = measures
-            .iter()
-            .map(|&(safety, class)| is_blocked(class, safety, &config))
-            .collect();
-        let clearance = clearance_in_metres(&blocked, region.dims(), resolution.size());
-        let required = (config.vehicle_radius + 3f64.sqrt() * resolution.size()) as f32;
-        let unknown_cost = match config.unknown {
-            UnknownPolicy::Cost(c) => c,
-            UnknownPolicy::Forbid => 0.0,
-        };
-        let preferred = config.preferred_clearance.max(1e-9) as f32;
-        let mut traversable = vec![false; n];
-        let mut rate = vec![f32::INFINITY; n];
-        for i in 0..n {
-            let (safety, class) = measures[i];
-            if blocked[i] || clearance[i] < required {
-                continue;
-            }
-            traversable[i] = true;
-            let unknown = if class == VoxelClass::Unknown {
-                unknown_cost
-            } else {
-                0.0
-            };
-            rate[i] = 1.0
-                + config.safety_weight * (1.0 - safety)
-                + config.clearance_weight * (1.0 - clearance[i] / preferred).max(0.0)
-                + unknown;
-        }
-        let min_rate = rate.iter().copied().fold(f32::INFINITY, f32::min).max(1.0);
-        Ok(Self {
+        let mut field = Self {
             region,
             resolution,
             config,
-            traversable,
-            class: measures.iter().map(|m| m.1).collect(),
-            safety: measures.iter().map(|m| m.0).collect(),
-            clearance,
-            rate,
-            min_rate,
-        })
+            voxels: vec![Voxel::UNKNOWN; n],
+            min_rate: 1.0,
+        };
+        // Every voxel of the region lies in one of the blocks of its box.
+        let (lo, hi) = (region.min().block(), region.key_at(n - 1).block());
+        let blocks = (lo.z..=hi.z).flat_map(|z| {
+            (lo.y..=hi.y).flat_map(move |y| (lo.x..=hi.x).map(move |x| BlockKey::new(x, y, z)))
+        });
+        for voxels in read_parts(map, &region, &block_parts(&region, blocks), |i, s, c| {
+            Some((i, s, c))
+        }) {
+            for (i, safety, class) in voxels {
+                field.voxels[i].safety = safety;
+                field.voxels[i].class = class;
+            }
+        }
+        let whole = region.dims().map(|d| 0..d as i64);
+        field.recompute_clearance(&whole);
+        for i in 0..n {
+            field.derive(i);
+        }
+        field.refresh_min_rate();
+        Ok(field)
+    }
+
+    /// The clearance the vehicle needs: its radius plus `√3 × resolution`.
+    pub fn required_clearance(&self) -> f64 {
+        self.config.vehicle_radius + 3f64.sqrt() * self.resolution.size()
+    }
+
+    /// The largest clearance the field tells apart: the required or the preferred clearance,
+    /// whichever is larger. Nothing the planner decides changes beyond it (a voxel that far
+    /// from every blocked voxel is traversable and pays no clearance penalty), so clearances
+    /// are exact up to this value and reported as this value beyond it; that keeps the effect
+    /// of a changed voxel within this distance, which [`CostField::update`] relies on.
+    pub fn clearance_cap(&self) -> f64 {
+        self.required_clearance()
+            .max(self.config.preferred_clearance)
+    }
+
+    /// Whole voxels within [`CostField::clearance_cap`] along one axis.
+    pub(super) fn reach(&self) -> i64 {
+        (self.clearance_cap() / self.resolution.size()).ceil() as i64
+    }
+
+    /// Recomputes the clearance of the voxels of `target` (ranges of region coordinates along
+    /// x, y, z) from the current blocked voxels: an exact distance transform over `target`
+    /// grown by [`CostField::reach`] on every side (space outside the region blocked), which
+    /// holds every blocked voxel within the cap of any voxel of `target`. Distances are whole
+    /// squared voxel counts, so the result does not depend on the box: a full build and an
+    /// update give the same bits.
+    pub(super) fn recompute_clearance(&mut self, target: &[std::ops::Range<i64>; 3]) {
+        let dims = self.region.dims().map(|d| d as i64);
+        let reach = self.reach();
+        // The context box, in region coordinates; -1 and `dims` are the blocked ring outside.
+        let context: [std::ops::Range<i64>; 3] = std::array::from_fn(|a| {
+            (target[a].start - reach).max(-1)..(target[a].end + reach).min(dims[a] + 1)
+        });
+        let size = context.clone().map(|r| (r.end - r.start) as usize);
+        let mut grid = Vec::with_capacity(size[0] * size[1] * size[2]);
+        for z in context[2].clone() {
+            for y in context[1].clone() {
+                for x in context[0].clone() {
+                    let inside =
+                        x >= 0 && y >= 0 && z >= 0 && x < dims[0] && y < dims[1] && z < dims[2];
+                    grid.push(
+                        !inside || {
+                            let i = (x + dims[0] * (y + dims[1] * z)) as usize;
+                            let v = &self.voxels[i];
+                            is_blocked(v.class, v.safety, &self.config)
+                        },
+                    );
+                }
+            }
+        }
+        let squared = squared_distance_transform(&grid, size);
+        let (voxel, cap) = (self.resolution.size(), self.clearance_cap());
+        for z in target[2].clone() {
+            for y in target[1].clone() {
+                for x in target[0].clone() {
+                    let c = (x - context[0].start)
+                        + size[0] as i64
+                            * ((y - context[1].start) + size[1] as i64 * (z - context[2].start));
+                    let i = (x + dims[0] * (y + dims[1] * z)) as usize;
+                    self.voxels[i].clearance =
+                        (f64::from(squared[c as usize]).sqrt() * voxel).min(cap) as f32;
+                }
+            }
+        }
+    }
+
+    /// Sets whether the voxel at `index` is traversable and its rate, from its class, safety
+    /// and clearance.
+    #[inline]
+    pub(super) fn derive(&mut self, i: usize) {
+        let v = self.voxels[i];
+        (self.voxels[i].traversable, self.voxels[i].rate) =
+            self.entry(v.class, v.safety, v.clearance);
+    }
+
+    /// Whether a voxel of this class, safety and clearance is traversable, and its rate.
+    #[inline]
+    pub(super) fn entry(&self, class: VoxelClass, safety: f32, clearance: f32) -> (bool, f32) {
+        let required = self.required_clearance() as f32;
+        let traversable = !is_blocked(class, safety, &self.config) && clearance >= required;
+        let rate = if traversable {
+            let unknown = match (class, self.config.unknown) {
+                (VoxelClass::Unknown, UnknownPolicy::Cost(c)) => c,
+                _ => 0.0,
+            };
+            let preferred = self.config.preferred_clearance.max(1e-9) as f32;
+            1.0 + self.config.safety_weight * (1.0 - safety)
+                + self.config.clearance_weight * (1.0 - clearance / preferred).max(0.0)
+                + unknown
+        } else {
+            f32::INFINITY
+        };
+        (traversable, rate)
+    }
+
+    /// Recomputes [`CostField::min_rate`]. (Eight running minima, so that the loop vectorises;
+    /// rates are never NaN, so the order of comparisons does not matter.)
+    pub(super) fn refresh_min_rate(&mut self) {
+        let mut lanes = [f32::INFINITY; 8];
+        let chunks = self.voxels.chunks_exact(8);
+        let rest = chunks.remainder();
+        for chunk in chunks {
+            for (lane, v) in lanes.iter_mut().zip(chunk) {
+                *lane = if v.rate < *lane { v.rate } else { *lane };
+            }
+        }
+        let least = lanes
+            .iter()
+            .copied()
+            .chain(rest.iter().map(|v| v.rate))
+            .fold(f32::INFINITY, |a, b| if b < a { b } else { a });
+        self.min_rate = least.max(1.0);
+    }
+
+    /// Writes a changed voxel's class, safety, traversability and rate.
+    pub(super) fn set_entries(&mut self, change: &Change) {
+        let i = change.index;
+        let v = &mut self.voxels[i];
+        v.safety = change.safety;
+        v.class = change.class;
+        v.traversable = change.traversable;
+        v.rate = change.rate;
+    }
+
+    /// Whether the stored class and safety of the voxel at `index` are these.
+    pub(super) fn has_measures(&self, i: usize, safety: f32, class: VoxelClass) -> bool {
+        let v = &self.voxels[i];
+        v.class == class && v.safety.to_bits() == safety.to_bits()
     }
 
     /// The region.
@@ -202,7 +331,7 @@ impl CostField {
     /// Whether the voxel at a dense index may be entered.
     #[inline]
     pub fn is_traversable(&self, index: usize) -> bool {
-        self.traversable.get(index).copied().unwrap_or(false)
+        self.voxels.get(index).is_some_and(|v| v.traversable)
     }
 
     /// Whether the voxel at a dense index is blocked itself (occupied, ambiguous, free with
@@ -215,10 +344,9 @@ impl CostField {
 
     /// Class of the voxel at a dense index ([`VoxelClass::Unknown`] outside the region).
     pub fn class(&self, index: usize) -> VoxelClass {
-        self.class
+        self.voxels
             .get(index)
-            .copied()
-            .unwrap_or(VoxelClass::Unknown)
+            .map_or(VoxelClass::Unknown, |v| v.class)
     }
 
     /// Why the voxel at a dense index may not be entered, or `None` when it may (or lies
@@ -245,7 +373,7 @@ impl CostField {
         let margin = 3f64.sqrt() * self.resolution.size();
         Some(Blocker::TooClose {
             clearance,
-            required: self.config.vehicle_radius + margin,
+            required: self.required_clearance(),
             vehicle_radius: self.config.vehicle_radius,
             largest_radius: clearance - margin,
             nearest: self.nearest_blocked(index, clearance),
@@ -302,18 +430,18 @@ impl CostField {
 
     /// Safety of the voxel at a dense index.
     pub fn safety(&self, index: usize) -> f32 {
-        self.safety.get(index).copied().unwrap_or(0.0)
+        self.voxels.get(index).map_or(0.0, |v| v.safety)
     }
 
     /// Clearance (metres) of the voxel at a dense index.
     pub fn clearance(&self, index: usize) -> f32 {
-        self.clearance.get(index).copied().unwrap_or(0.0)
+        self.voxels.get(index).map_or(0.0, |v| v.clearance)
     }
 
     /// Cost per metre of entering the voxel at a dense index (infinite when not traversable).
     #[inline]
     pub fn rate(&self, index: usize) -> f32 {
-        self.rate.get(index).copied().unwrap_or(f32::INFINITY)
+        self.voxels.get(index).map_or(f32::INFINITY, |v| v.rate)
     }
 
     /// The lowest cost per metre of any traversable voxel (at least 1): every step of length `l`
@@ -330,11 +458,10 @@ impl CostField {
 
     /// Number of traversable voxels.
     pub fn traversable_count(&self) -> usize {
-        self.traversable.iter().filter(|t| **t).count()
+        self.voxels.iter().filter(|v| v.traversable).count()
     }
 }
 
-/// Whether a voxel of this class and safety is blocked under `config`.
 /// Whether a voxel of `class` and `safety` is blocked under `config` (occupied, ambiguous, free
 /// with safety below the threshold, or unknown while unknown space is forbidden).
 pub fn is_blocked(class: VoxelClass, safety: f32, config: &PlannerConfig) -> bool {
@@ -343,29 +470,4 @@ pub fn is_blocked(class: VoxelClass, safety: f32, config: &PlannerConfig) -> boo
         VoxelClass::Unknown => !matches!(config.unknown, UnknownPolicy::Cost(_)),
         VoxelClass::Free => safety < config.safety_threshold,
     }
-}
-
-/// Clearance in metres to the nearest blocked voxel, with everything outside the grid blocked.
-fn clearance_in_metres(blocked: &[bool], dims: [usize; 3], size: f64) -> Vec<f32> {
-    let [nx, ny, nz] = dims;
-    let padded = [nx + 2, ny + 2, nz + 2];
-    let mut grid = vec![true; padded[0] * padded[1] * padded[2]];
-    for z in 0..nz {
-        for y in 0..ny {
-            let from = nx * (y + ny * z);
-            let to = 1 + padded[0] * ((y + 1) + padded[1] * (z + 1));
-            grid[to..to + nx].copy_from_slice(&blocked[from..from + nx]);
-        }
-    }
-    let squared = squared_distance_transform(&grid, padded);
-    let mut clearance = vec![0.0; nx * ny * nz];
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                let p = (x + 1) + padded[0] * ((y + 1) + padded[1] * (z + 1));
-                clearance[x + nx * (y + ny * z)] = (f64::from(squared[p]).sqrt() * size) as f32;
-            }
-        }
-    }
-    clearance
 }

@@ -9,82 +9,134 @@ use rayon::prelude::*;
 /// Lines are processed in parallel; the result does not depend on the thread count.
 pub fn squared_distance_transform(blocked: &[bool], dims: [usize; 3]) -> Vec<f32> {
     let [nx, ny, nz] = dims;
-    let mut d: Vec<f32> = blocked
-        .iter()
-        .map(|&b| if b { 0.0 } else { f32::INFINITY })
-        .collect();
-    if d.len() != nx * ny * nz || d.is_empty() {
-        return d;
+    if blocked.len() != nx * ny * nz || blocked.is_empty() {
+        return blocked
+            .iter()
+            .map(|&b| if b { 0.0 } else { f32::INFINITY })
+            .collect();
     }
-    // Along x: rows are contiguous.
-    d.par_chunks_mut(nx).for_each(transform_line);
-    // Along y and z: gather each line, transform, scatter back. Planes are independent.
-    d.par_chunks_mut(nx * ny).for_each(|plane| {
-        let mut line = vec![0.0; ny];
-        for x in 0..nx {
-            for (y, v) in line.iter_mut().enumerate() {
-                *v = plane[x + nx * y];
+    // Along x: rows are contiguous, and on a 0/∞ input the envelope is the distance to the
+    // nearest blocked voxel of the row, found by two sweeps.
+    let mut d = vec![0.0f32; blocked.len()];
+    d.par_chunks_mut(nx)
+        .zip(blocked.par_chunks(nx))
+        .for_each(|(row, blocked)| nearest_in_row(row, blocked));
+    // Along y: planes are independent; each column is gathered, transformed, scattered.
+    d.par_chunks_mut(nx * ny)
+        .for_each_init(Envelope::default, |envelope, plane| {
+            let mut line = vec![0.0; ny];
+            for x in 0..nx {
+                for (y, v) in line.iter_mut().enumerate() {
+                    *v = plane[x + nx * y];
+                }
+                envelope.transform(&mut line);
+                for (y, v) in line.iter().enumerate() {
+                    plane[x + nx * y] = *v;
+                }
             }
-            transform_line(&mut line);
-            for (y, v) in line.iter().enumerate() {
-                plane[x + nx * y] = *v;
-            }
-        }
-    });
+        });
+    // Along z: each y slab (all x and z for one y) is transformed into its own buffer, z
+    // major, then copied back plane by plane.
     let plane = nx * ny;
-    let columns: Vec<Vec<f32>> = (0..plane)
+    let slabs: Vec<Vec<f32>> = (0..ny)
         .into_par_iter()
-        .map(|i| {
-            let mut line: Vec<f32> = (0..nz).map(|z| d[i + plane * z]).collect();
-            transform_line(&mut line);
-            line
+        .map_init(Envelope::default, |envelope, y| {
+            let mut slab = vec![0.0; nx * nz];
+            let mut line = vec![0.0; nz];
+            for x in 0..nx {
+                for (z, v) in line.iter_mut().enumerate() {
+                    *v = d[x + nx * y + plane * z];
+                }
+                envelope.transform(&mut line);
+                for (z, v) in line.iter().enumerate() {
+                    slab[x + nx * z] = *v;
+                }
+            }
+            slab
         })
         .collect();
-    for (i, line) in columns.into_iter().enumerate() {
-        for (z, v) in line.into_iter().enumerate() {
-            d[i + plane * z] = v;
+    d.par_chunks_mut(plane).enumerate().for_each(|(z, out)| {
+        for (y, slab) in slabs.iter().enumerate() {
+            out[nx * y..nx * (y + 1)].copy_from_slice(&slab[nx * z..nx * (z + 1)]);
         }
-    }
+    });
     d
 }
 
-/// In place: `f(q) ← min_p (q - p)² + f(p)` over one line.
-fn transform_line(f: &mut [f32]) {
-    let n = f.len();
-    let sampled: Vec<f64> = f.iter().map(|&v| f64::from(v)).collect();
-    let finite: Vec<usize> = (0..n).filter(|&q| sampled[q].is_finite()).collect();
-    if finite.is_empty() {
-        return;
-    }
-    let intersection = |p: usize, q: usize| {
-        let (pf, qf) = (p as f64, q as f64);
-        ((sampled[q] + qf * qf) - (sampled[p] + pf * pf)) / (2.0 * (qf - pf))
-    };
-    // Lower envelope of the parabolas rooted at the finite samples: parabola `roots[k]` is the
-    // lowest between `bounds[k]` and `bounds[k + 1]`.
-    let mut roots = vec![finite[0]];
-    let mut bounds = vec![f64::NEG_INFINITY, f64::INFINITY];
-    for &q in &finite[1..] {
-        let mut s = intersection(roots[roots.len() - 1], q);
-        // bounds[0] is −∞, so the first parabola is never popped.
-        while s <= bounds[roots.len() - 1] {
-            roots.pop();
-            bounds.pop();
-            s = intersection(roots[roots.len() - 1], q);
+/// The squared distance along one row to its nearest blocked voxel (∞ when none is).
+fn nearest_in_row(row: &mut [f32], blocked: &[bool]) {
+    let mut last: Option<usize> = None;
+    for (q, (out, &b)) in row.iter_mut().zip(blocked).enumerate() {
+        if b {
+            last = Some(q);
         }
-        let last = bounds.len() - 1;
-        bounds[last] = s;
-        bounds.push(f64::INFINITY);
-        roots.push(q);
+        *out = last.map_or(f32::INFINITY, |p| ((q - p) * (q - p)) as f32);
     }
-    let mut k = 0;
-    for (q, out) in f.iter_mut().enumerate() {
-        let x = q as f64;
-        while bounds[k + 1] < x {
-            k += 1;
+    let mut next: Option<usize> = None;
+    for (q, (out, &b)) in row.iter_mut().zip(blocked).enumerate().rev() {
+        if b {
+            next = Some(q);
         }
-        let p = roots[k] as f64;
-        *out = ((x - p) * (x - p) + sampled[roots[k]]) as f32;
+        if let Some(p) = next {
+            *out = out.min(((p - q) * (p - q)) as f32);
+        }
+    }
+}
+
+/// Working memory of the 1D transform, reused across lines.
+#[derive(Default)]
+struct Envelope {
+    sampled: Vec<f64>,
+    roots: Vec<usize>,
+    bounds: Vec<f64>,
+}
+
+impl Envelope {
+    /// In place: `f(q) ← min_p (q - p)² + f(p)` over one line.
+    fn transform(&mut self, f: &mut [f32]) {
+        self.sampled.clear();
+        self.sampled.extend(f.iter().map(|&v| f64::from(v)));
+        let sampled = &self.sampled;
+        let (roots, bounds) = (&mut self.roots, &mut self.bounds);
+        roots.clear();
+        bounds.clear();
+        let intersection = |p: usize, q: usize| {
+            let (pf, qf) = (p as f64, q as f64);
+            ((sampled[q] + qf * qf) - (sampled[p] + pf * pf)) / (2.0 * (qf - pf))
+        };
+        // Lower envelope of the parabolas rooted at the finite samples: parabola `roots[k]`
+        // is the lowest between `bounds[k]` and `bounds[k + 1]`.
+        bounds.push(f64::NEG_INFINITY);
+        for q in (0..f.len()).filter(|&q| sampled[q].is_finite()) {
+            if roots.is_empty() {
+                roots.push(q);
+                bounds.push(f64::INFINITY);
+                continue;
+            }
+            let mut s = intersection(roots[roots.len() - 1], q);
+            // bounds[0] is −∞, so the first parabola is never popped.
+            while s <= bounds[roots.len() - 1] {
+                roots.pop();
+                bounds.pop();
+                s = intersection(roots[roots.len() - 1], q);
+            }
+            let last = bounds.len() - 1;
+            bounds[last] = s;
+            bounds.push(f64::INFINITY);
+            roots.push(q);
+        }
+        if roots.is_empty() {
+            return;
+        }
+        let mut k = 0;
+        for (q, out) in f.iter_mut().enumerate() {
+            let x = q as f64;
+            while bounds[k + 1] < x {
+                k += 1;
+            }
+            let p = roots[k] as f64;
+            *out = ((x - p) * (x - p) + sampled[roots[k]]) as f32;
+        }
     }
 }
 

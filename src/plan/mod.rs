@@ -15,13 +15,18 @@
 //!    consistent heuristic over the same graph, then shortcuts the path by line of sight and
 //!    merges collinear waypoints. A start or goal it may not enter is refused with a
 //!    [`Blocker`] that says why and which setting would change it.
+//! 5. [`Planner`] owns a region's field and keeps it current as the map grows: it updates only
+//!    around the blocks the map reports changed ([`VoxelMap::changed_blocks_since`](crate::VoxelMap::changed_blocks_since)),
+//!    with exactly the result of a full build, so a closed loop can replan every frame.
 
 mod astar;
 mod blocker;
 mod config;
 mod cost_field;
 mod edt;
+mod field_update;
 mod graph;
+mod planner;
 mod queries;
 
 pub use astar::{Path, PlanError, plan_in_field, plan_path};
@@ -29,5 +34,7 @@ pub use blocker::{Blocker, NearestBlocked, ObservedExtent};
 pub use config::{PlannerConfig, UnknownPolicy};
 pub use cost_field::{CostField, PlanningRegion, is_blocked};
 pub use edt::squared_distance_transform;
+pub use field_update::FieldUpdate;
 pub use graph::{VoxelEdge, VoxelGraph};
+pub use planner::Planner;
 pub use queries::SafetyQueries;

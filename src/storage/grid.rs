@@ -11,11 +11,20 @@ use crate::measures::VoxelClass;
 /// Blocks are stored in a `Vec` in allocation order with a hash index from block key to
 /// position. Nothing observable depends on that order: iteration in key order is available
 /// through [`BlockGrid::sorted_block_keys`], and saved files use it.
+///
+/// The grid counts its writes: every call that may change cells advances a version, and each
+/// block remembers the version of its last write, so any number of consumers (a planner's cost
+/// field, an exporter) can each ask which blocks changed since the version they last saw
+/// ([`BlockGrid::changed_since`]) without the grid keeping a dirty set per consumer.
 #[derive(Clone, Debug, Default)]
 pub struct BlockGrid<C> {
     index: FxHashMap<BlockKey, usize>,
     keys: Vec<BlockKey>,
     blocks: Vec<Box<Block<C>>>,
+    /// Per block (in storage order), the version of its last write.
+    written: Vec<u64>,
+    /// Advanced by every call that may write cells.
+    version: u64,
 }
 
 impl<C: Copy + Default> BlockGrid<C> {
@@ -25,7 +34,39 @@ impl<C: Copy + Default> BlockGrid<C> {
             index: FxHashMap::default(),
             keys: Vec::new(),
             blocks: Vec::new(),
+            written: Vec::new(),
+            version: 0,
         }
+    }
+
+    /// The grid's version: advanced by every call that may write cells.
+    pub fn version(&self) -> u64 {
+        self.version
+    }
+
+    /// Keys of the blocks written after `version` (allocated ones included), in ascending
+    /// order. `changed_since(0)` lists every block written since the grid was created.
+    pub fn changed_since(&self, version: u64) -> Vec<BlockKey> {
+        let mut keys: Vec<BlockKey> = self
+            .keys
+            .iter()
+            .zip(&self.written)
+            .filter(|(_, written)| **written > version)
+            .map(|(key, _)| *key)
+            .collect();
+        keys.sort_unstable();
+        keys
+    }
+
+    /// Starts a write: advances the version and returns it.
+    fn begin_write(&mut self) -> u64 {
+        self.version += 1;
+        self.version
+    }
+
+    /// Records a write to the block at `position` in the current version.
+    fn mark(&mut self, position: usize) {
+        self.written[position] = self.version;
     }
 
     /// Number of allocated blocks.
@@ -58,7 +99,10 @@ impl<C: Copy + Default> BlockGrid<C> {
     /// The block at `key` for writing, if allocated.
     #[inline]
     pub fn block_mut(&mut self, key: BlockKey) -> Option<&mut Block<C>> {
-        self.position(key).map(|i| &mut *self.blocks[i])
+        let i = self.position(key)?;
+        self.begin_write();
+        self.mark(i);
+        Some(&mut *self.blocks[i])
     }
 
     /// The position of the block at `key`, allocating an empty block when there is none.
@@ -66,21 +110,30 @@ impl<C: Copy + Default> BlockGrid<C> {
         if let Some(&i) = self.index.get(&key) {
             return i;
         }
+        self.begin_write();
+        self.push(key, Box::default())
+    }
+
+    /// Appends a block that is not allocated yet, written in the current version.
+    fn push(&mut self, key: BlockKey, block: Box<Block<C>>) -> usize {
         let i = self.blocks.len();
         self.index.insert(key, i);
         self.keys.push(key);
-        self.blocks.push(Box::default());
+        self.blocks.push(block);
+        self.written.push(self.version);
         i
     }
 
     /// Inserts (or replaces) a whole block.
     pub fn insert_block(&mut self, key: BlockKey, block: Box<Block<C>>) {
+        self.begin_write();
         match self.index.get(&key) {
-            Some(&i) => self.blocks[i] = block,
+            Some(&i) => {
+                self.blocks[i] = block;
+                self.mark(i);
+            }
             None => {
-                self.index.insert(key, self.blocks.len());
-                self.keys.push(key);
-                self.blocks.push(block);
+                self.push(key, block);
             }
         }
     }
@@ -94,6 +147,8 @@ impl<C: Copy + Default> BlockGrid<C> {
     /// The block at a storage position, for writing.
     #[inline]
     pub fn block_at_mut(&mut self, position: usize) -> &mut Block<C> {
+        self.begin_write();
+        self.mark(position);
         &mut self.blocks[position]
     }
 
@@ -107,6 +162,8 @@ impl<C: Copy + Default> BlockGrid<C> {
     #[inline]
     pub fn cell_or_insert(&mut self, key: VoxelKey) -> &mut C {
         let i = self.ensure_block(key.block());
+        self.begin_write();
+        self.mark(i);
         &mut self.blocks[i].cells[key.cell_index()]
     }
 
@@ -119,8 +176,10 @@ impl<C: Copy + Default> BlockGrid<C> {
     }
 
     /// Allocated blocks with their keys, in storage order, for writing. Each item is a distinct
-    /// block, so the slice can be split across threads.
+    /// block, so the slice can be split across threads. Every block counts as written.
     pub fn blocks_mut(&mut self) -> (&[BlockKey], &mut [Box<Block<C>>]) {
+        let version = self.begin_write();
+        self.written.fill(version);
         (&self.keys, &mut self.blocks)
     }
 
@@ -230,7 +289,8 @@ impl<C: Copy + Default> BlockGrid<C> {
 
     /// Like [`BlockGrid::update_from`] for any per-block payload: `sources` pairs block keys
     /// with what each block is updated from. Missing blocks are allocated in key order, so
-    /// the storage order does not depend on the order of `sources`.
+    /// the storage order does not depend on the order of `sources`. Every block with a source
+    /// counts as written.
     pub fn update_blocks<S: Sync>(
         &mut self,
         mut sources: Vec<(BlockKey, &S)>,
@@ -240,6 +300,7 @@ impl<C: Copy + Default> BlockGrid<C> {
         C: Send + Sync,
     {
         sources.sort_unstable_by_key(|(key, _)| *key);
+        self.begin_write();
         let missing: Vec<BlockKey> = sources
             .iter()
             .map(|(key, _)| *key)
@@ -248,12 +309,13 @@ impl<C: Copy + Default> BlockGrid<C> {
         // The (page-faulting) allocations run in parallel; the insertions are cheap.
         let fresh: Vec<Box<Block<C>>> = missing.par_iter().map(|_| Box::default()).collect();
         for (key, block) in missing.into_iter().zip(fresh) {
-            self.insert_block(key, block);
+            self.push(key, block);
         }
         let mut by_position: Vec<Option<&S>> = vec![None; self.blocks.len()];
         for (key, source) in sources {
             if let Some(position) = self.position(key) {
                 by_position[position] = Some(source);
+                self.mark(position);
             }
         }
         self.blocks
@@ -272,6 +334,7 @@ impl<C: Copy + Default> BlockGrid<C> {
         self.blocks.capacity() * std::mem::size_of::<Box<Block<C>>>()
             + self.blocks.len() * (block - std::mem::size_of::<Box<Block<C>>>())
             + self.keys.capacity() * key
+            + self.written.capacity() * std::mem::size_of::<u64>()
             + self.index.capacity() * entry
     }
 }
@@ -331,5 +394,42 @@ mod tests {
         assert!(grid.any_in_box(&huge, occ, classify));
         assert_eq!(grid.cells_in_box(&row).count(), 16);
         assert_eq!(grid.cells_in_box(&huge).count(), 2 * 512);
+    }
+
+    #[test]
+    fn versions_name_the_blocks_written_since() {
+        let mut grid = BlockGrid::<u8>::new();
+        let start = grid.version();
+        *grid.cell_or_insert(VoxelKey::new(0, 0, 0)) = 1;
+        let (a, b) = (
+            VoxelKey::new(0, 0, 0).block(),
+            VoxelKey::new(20, 0, 0).block(),
+        );
+        assert_eq!(grid.changed_since(start), vec![a]);
+        let after_first = grid.version();
+        assert!(grid.changed_since(after_first).is_empty());
+        // A batch update marks the blocks it had a source for, allocated or not.
+        let source = 7u8;
+        grid.update_blocks(vec![(b, &source)], |block, s| {
+            block.cells[0] = *s;
+            1
+        });
+        assert_eq!(grid.changed_since(after_first), vec![b]);
+        assert_eq!(grid.changed_since(start), vec![a, b]);
+        // Reads leave the version alone; every write path advances it.
+        let read = grid.version();
+        let _ = grid.cell(VoxelKey::new(0, 0, 0));
+        let _ = grid.block(a);
+        assert_eq!(grid.version(), read);
+        grid.block_mut(a);
+        assert_eq!(grid.changed_since(read), vec![a]);
+        let again = grid.version();
+        grid.blocks_mut();
+        assert_eq!(grid.changed_since(again), vec![a, b]);
+        let last = grid.version();
+        let position = grid.position(b).unwrap();
+        grid.block_at_mut(position);
+        grid.insert_block(a, Box::default());
+        assert_eq!(grid.changed_since(last), vec![a, b]);
     }
 }

@@ -1,0 +1,63 @@
+//! One cycle of the closed loop at 320 × 240, and the cost field's incremental update beside a
+//! full rebuild of the same field.
+//!
+//! A vehicle flies the first goal of the random scenario (seed 3) for a few frames; from that
+//! state, each measured iteration is the vehicle's work on its next frame ([`Flight::see`]:
+//! depth stage, integration, cost-field update, path check or replanning), on a fresh copy of
+//! the state. Rendering the frame (the simulator's work) is outside the measured loop.
+//! `field/update_after_one_frame` updates the planner's field after that frame;
+//! `field/full_rebuild` builds the same field from scratch.
+//!
+//! Run: `cargo bench --bench fly`.
+
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use fuzzyvox::fly::{Flight, FlyConfig, FlyModel, draw_goals, integrate_prior};
+use fuzzyvox::plan::CostField;
+use fuzzyvox::sim::scenario;
+
+/// Frames flown before the measured one: far enough that the map holds several depth images.
+const WARM_UP_CYCLES: usize = 6;
+
+fn cycle(c: &mut Criterion) {
+    let scenario = scenario::random(10, 3).expect("scenario");
+    let config = FlyConfig::default();
+    let goal = draw_goals(&scenario, &config, 1, 3).expect("goals")[0];
+    for model in [FlyModel::Fuzzy, FlyModel::LogOdds] {
+        let mut map = model.new_map(config.resolution).expect("map");
+        integrate_prior(&scenario, &mut map, &goal.start, &config).expect("prior");
+        let mut flight = Flight::new(&scenario, &goal, &map, &config, 3).expect("flight");
+        for _ in 0..WARM_UP_CYCLES {
+            flight.cycle(&mut map).expect("cycle");
+        }
+        assert!(flight.ending().is_none(), "the flight ended during warm-up");
+        let frame = flight.clone().render().expect("frame");
+        // The state after the measured frame, for the field benchmarks.
+        let (mut after, mut seen) = (flight.clone(), map.clone());
+        after.see(frame.clone(), &mut seen).expect("see");
+
+        let mut group = c.benchmark_group(format!("fly_320x240_{}", model.name()));
+        group.sample_size(20);
+        group.bench_function("cycle", |b| {
+            b.iter_batched(
+                || (flight.clone(), map.clone(), frame.clone()),
+                |(mut flight, mut map, frame)| flight.see(frame, &mut map).expect("see"),
+                BatchSize::LargeInput,
+            )
+        });
+        group.bench_function("field/update_after_one_frame", |b| {
+            b.iter_batched(
+                || flight.planner().clone(),
+                |mut planner| planner.update(seen.as_map()),
+                BatchSize::LargeInput,
+            )
+        });
+        let field = flight.planner().field();
+        group.bench_function("field/full_rebuild", |b| {
+            b.iter(|| CostField::build(seen.as_map(), *field.region(), *field.config()).unwrap())
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, cycle);
+criterion_main!(benches);
