@@ -84,6 +84,21 @@ impl PlanningRegion {
             .then(|| (x + nx * (y + ny * z)) as usize)
     }
 
+    /// The dense index of the voxel at region coordinates `[x, y, z]` (each from 0 to its
+    /// dimension, unchecked).
+    #[inline]
+    pub(super) fn index_at(&self, [x, y, z]: [i64; 3]) -> usize {
+        let [nx, ny, _] = self.dims.map(|d| d as i64);
+        (x + nx * (y + ny * z)) as usize
+    }
+
+    /// The region coordinates `[x, y, z]` of a dense index.
+    #[inline]
+    pub(super) fn coordinates_at(&self, index: usize) -> [i64; 3] {
+        let [nx, ny, _] = self.dims;
+        [index % nx, (index / nx) % ny, index / (nx * ny)].map(|c| c as i64)
+    }
+
     /// The key at a dense index.
     #[inline]
     pub fn key_at(&self, index: usize) -> VoxelKey {
@@ -225,8 +240,7 @@ impl CostField {
                         x >= 0 && y >= 0 && z >= 0 && x < dims[0] && y < dims[1] && z < dims[2];
                     grid.push(
                         !inside || {
-                            let i = (x + dims[0] * (y + dims[1] * z)) as usize;
-                            let v = &self.voxels[i];
+                            let v = &self.voxels[self.region.index_at([x, y, z])];
                             is_blocked(v.class, v.safety, &self.config)
                         },
                     );
@@ -241,7 +255,7 @@ impl CostField {
                     let c = (x - context[0].start)
                         + size[0] as i64
                             * ((y - context[1].start) + size[1] as i64 * (z - context[2].start));
-                    let i = (x + dims[0] * (y + dims[1] * z)) as usize;
+                    let i = self.region.index_at([x, y, z]);
                     self.voxels[i].clearance =
                         (f64::from(squared[c as usize]).sqrt() * voxel).min(cap) as f32;
                 }

@@ -30,7 +30,8 @@ pub struct FieldUpdate {
     pub voxels_flipped: usize,
     /// Voxels whose clearance was recomputed (around the flipped ones).
     pub clearance_voxels: usize,
-    /// Whether the whole field was rebuilt (the map does not report its changes).
+    /// Whether the whole field was rebuilt (the map's write version went backwards, or it
+    /// stopped or started reporting one: the field could not know what changed).
     pub rebuilt: bool,
 }
 
@@ -57,7 +58,6 @@ impl CostField {
     /// updated map, as long as no voxel of the region changed outside `blocks`.
     pub fn update(&mut self, map: &dyn VoxelMap, blocks: &[BlockKey]) -> FieldUpdate {
         let region = *self.region();
-        let lowest = region.min();
         let dims = region.dims().map(|d| d as i64);
         let parts = block_parts(&region, blocks.iter().copied());
         let mut stats = FieldUpdate {
@@ -96,8 +96,7 @@ impl CostField {
                 self.set_entries(change);
                 if change.flipped {
                     stats.voxels_flipped += 1;
-                    let at = region.key_at(change.index);
-                    let c = [at.x - lowest.x, at.y - lowest.y, at.z - lowest.z].map(i64::from);
+                    let c = region.coordinates_at(change.index);
                     let b = flips.get_or_insert_with(|| c.map(|v| v..v + 1));
                     for a in 0..3 {
                         b[a] = b[a].start.min(c[a])..b[a].end.max(c[a] + 1);
@@ -120,7 +119,7 @@ impl CostField {
             self.recompute_clearance(&target);
             for_each_voxel(&target, |x, y, z| {
                 stats.clearance_voxels += 1;
-                self.derive((x + dims[0] * (y + dims[1] * z)) as usize);
+                self.derive(region.index_at([x, y, z]));
             });
         }
         self.refresh_min_rate();
@@ -128,7 +127,9 @@ impl CostField {
     }
 }
 
-/// Each block's part of the region (blocks that miss it are dropped), in region coordinates.
+/// Each block's part of the region (blocks that miss it are dropped), in region coordinates,
+/// in z, y, x order of the blocks: the field is stored x fastest, so neighbours along x, which
+/// share cache lines of the field, follow each other.
 pub(super) fn block_parts(
     region: &PlanningRegion,
     blocks: impl Iterator<Item = BlockKey>,
@@ -136,7 +137,7 @@ pub(super) fn block_parts(
     let lowest = region.min();
     let low = [lowest.x, lowest.y, lowest.z];
     let dims = region.dims().map(|d| d as i64);
-    blocks
+    let mut parts: Vec<(BlockKey, VoxelBox)> = blocks
         .filter_map(|block| {
             let origin = block.origin();
             let from = [origin.x, origin.y, origin.z];
@@ -148,24 +149,21 @@ pub(super) fn block_parts(
                 .all(|r| r.start < r.end)
                 .then_some((block, part))
         })
-        .collect()
+        .collect();
+    parts.sort_unstable_by_key(|(b, _)| (b.z, b.y, b.x));
+    parts
 }
 
 /// `visit(dense index, safety, class)` for every voxel of `parts`, keeping what it returns,
-/// one list per part: each block is read from the map once, in parallel. The field is stored x
-/// fastest, so the parts are visited in z, y, x order of their blocks: neighbours along x,
-/// which share cache lines of the field's arrays, follow each other.
+/// one list per part: each block is read from the map once, in parallel.
 pub(super) fn read_parts<T: Send>(
     map: &dyn VoxelMap,
     region: &PlanningRegion,
     parts: &[(BlockKey, VoxelBox)],
     visit: impl Fn(usize, f32, VoxelClass) -> Option<T> + Sync,
 ) -> Vec<Vec<T>> {
-    let dims = region.dims().map(|d| d as i64);
     let lowest = region.min();
     let measures = *map.measure_config();
-    let mut parts = parts.to_vec();
-    parts.sort_unstable_by_key(|(b, _)| (b.z, b.y, b.x));
     parts
         .par_iter()
         .map_init(
@@ -187,7 +185,7 @@ pub(super) fn read_parts<T: Send>(
                     for y in ys.clone() {
                         let cell =
                             ((xs.start - o[0]) + side * ((y - o[1]) + side * (z - o[2]))) as usize;
-                        let index = (xs.start + dims[0] * (y + dims[1] * z)) as usize;
+                        let index = region.index_at([xs.start, y, z]);
                         let row = &cells[cell..cell + (xs.end - xs.start) as usize];
                         for (i, m) in (index..).zip(row) {
                             let (safety, class) = measures.safety_and_class(*m);
