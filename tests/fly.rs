@@ -78,7 +78,12 @@ fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
         goal: Point3::new(1.1, 0.1, 1.1),
         truth_length: 12.0,
     };
-    let config = FlyConfig::default();
+    // A level camera (no pitch towards the descending path), flying straight.
+    let config = FlyConfig {
+        max_pitch: 0.0,
+        weave_angle: 0.0,
+        ..FlyConfig::default()
+    };
     let mut map = FlyModel::LogOdds.new_map(config.resolution).unwrap();
     integrate_prior(&plate, &mut map, &goal.start, &config).unwrap();
     let log = fly_goal(&plate, &goal, &mut map, &config, 1).unwrap();

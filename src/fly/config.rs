@@ -39,9 +39,31 @@ pub struct FlyConfig {
     /// The camera looks at the point this far ahead along the current path (horizontally).
     /// Default 3 m.
     pub look_ahead: f64,
+    /// The camera turns (yaws) at most this fast, degrees per second, so that consecutive
+    /// frames overlap and the depth stage can match them even when the path turns sharply.
+    /// Default 90 (22.5° per frame at the default frame interval).
+    pub max_yaw_rate: f64,
+    /// The camera pitches towards the point ahead when the path climbs or descends, at most
+    /// this many degrees up or down (turning at the yaw rate's limit). Default 40.
+    pub max_pitch: f64,
+    /// The vehicle weaves: each step leaves the direction of the path's next waypoint by this
+    /// angle, degrees, to the left and then to the right, so that what lies straight ahead on
+    /// the path is never at the epipole of the camera's motion (where depth from motion is
+    /// undefined). 0 flies straight. Default 25.
+    pub weave_angle: f64,
+    /// Frames between changes of the weaving side. Default 2.
+    pub weave_frames: usize,
     /// The planner keeps its path while it stays valid, but replans at least every this many
     /// frames to use what the map has learnt. Default 8.
     pub replan_every: usize,
+    /// The unseen-surface guard collects, within this distance of the vehicle, metres, the
+    /// unknown voxels next to surfaces the map has seen, and the planner neither enters them
+    /// nor passes within the vehicle's radius of them, whatever the unknown-space policy: see
+    /// [`UnknownGuard`](super::guard::UnknownGuard). 0 turns the guard off. Default 5.
+    pub unknown_guard: f64,
+    /// The guard forbids only unknown voxels within this distance of an occupied or ambiguous
+    /// voxel, metres: the unseen parts of surfaces the map has begun to see. Default 0.6.
+    pub guard_surface_reach: f64,
     /// Horizontal margin of the planning region around start and goal, metres. Default 6.
     pub region_margin: f64,
     /// Lowest and highest altitude of starts and goals, metres. Default 1.5 to 6.
@@ -70,7 +92,13 @@ impl Default for FlyConfig {
             },
             prior_radius: 2.0,
             look_ahead: 3.0,
+            max_yaw_rate: 90.0,
+            weave_angle: 25.0,
+            max_pitch: 40.0,
+            weave_frames: 2,
             replan_every: 8,
+            unknown_guard: 5.0,
+            guard_surface_reach: 0.6,
             region_margin: 6.0,
             altitude: (1.5, 6.0),
             distance: (8.0, 20.0),
@@ -99,14 +127,40 @@ impl FlyConfig {
         positive("time limit", self.time_limit)?;
         positive("prior radius", self.prior_radius)?;
         positive("look-ahead", self.look_ahead)?;
+        positive("maximum yaw rate", self.max_yaw_rate)?;
         positive("region margin", self.region_margin)?;
         positive("minimum depth", self.min_depth)?;
         positive("map range", self.map_range)?;
-        if !(self.surface_margin.is_finite() && self.surface_margin >= 0.0) {
+        for (name, value) in [
+            ("unknown guard", self.unknown_guard),
+            ("guard surface reach", self.guard_surface_reach),
+            ("surface margin", self.surface_margin),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    expected: "a finite distance >= 0 m",
+                });
+            }
+        }
+        for (name, value) in [
+            ("maximum pitch", self.max_pitch),
+            ("weave angle", self.weave_angle),
+        ] {
+            if !(0.0..=80.0).contains(&value) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    expected: "an angle from 0 to 80 degrees",
+                });
+            }
+        }
+        if self.weave_frames == 0 {
             return Err(Error::InvalidParameter {
-                name: "surface margin",
-                value: self.surface_margin,
-                expected: "a finite distance >= 0 m",
+                name: "weave frames",
+                value: 0.0,
+                expected: "at least 1 frame",
             });
         }
         for (name, (lo, hi)) in [("altitude", self.altitude), ("distance", self.distance)] {

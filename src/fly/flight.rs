@@ -8,11 +8,13 @@ use serde::Serialize;
 
 use super::config::FlyConfig;
 use super::goals::{Goal, planning_region};
+use super::guard::UnknownGuard;
 use crate::depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
 use crate::error::Result;
+use crate::geometry::PinholeIntrinsics;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
 use crate::map::AnyMap;
-use crate::plan::{CostField, PlanError, Planner, plan_in_field};
+use crate::plan::{CostField, PlanError, Planner, plan_in_field_avoiding};
 use crate::sim::render;
 use crate::sim::scenario::Scenario;
 use crate::sim::trajectory::look_at;
@@ -51,6 +53,8 @@ pub struct CycleTimes {
     /// path against it and, when the path is no longer clear (or every
     /// [`FlyConfig::replan_every`] frames), planning again.
     pub update_replan_ms: f64,
+    /// Updating the [`UnknownGuard`] (not part of `update_replan_ms`).
+    pub guard_ms: f64,
     /// A full rebuild of the cost field over the planning region, timed on every tenth cycle
     /// only (for comparison); `None` on the others.
     pub full_rebuild_ms: Option<f64>,
@@ -80,7 +84,8 @@ pub struct FlightLog {
 }
 
 /// The prior map: what the vehicle knows of its surroundings before take-off. Six true depth
-/// images from the start (four level directions, up and down), cut at the prior radius: the
+/// images from the start, the faces of a cube (four level directions, up and down, each with a
+/// 90° field of view, so that together they see every direction), cut at the prior radius: the
 /// surfaces within it and the free space in front of them, with full confidence.
 pub fn integrate_prior(
     scenario: &Scenario,
@@ -93,15 +98,18 @@ pub fn integrate_prior(
         Vector3::y(),
         -Vector3::x(),
         -Vector3::y(),
-        Vector3::new(0.01, 0.0, 1.0),
-        Vector3::new(0.01, 0.0, -1.0),
+        Vector3::new(1e-6, 0.0, 1.0),
+        Vector3::new(1e-6, 0.0, -1.0),
     ];
+    // A cube face: 90° across, a little wider so that neighbouring faces overlap.
+    let side = 128;
+    let half = f64::from(side) / 2.0;
+    let k = PinholeIntrinsics::new(side, side, half * 0.95, half * 0.95, half - 0.5, half - 0.5)?;
     let options = IntegrationOptions {
         max_range: Some(config.prior_radius),
     };
     for direction in directions {
         let pose = look_at(*start, direction);
-        let k = scenario.intrinsics;
         let view = render(&scenario.scene, &k, &pose, 0, scenario.max_range * 4.0);
         // Sky: far away, so that the ray clears free space up to the prior radius.
         let far = (scenario.max_range * 4.0) as f32;
@@ -156,11 +164,13 @@ pub struct Flight<'a> {
     params: DepthParams,
     options: IntegrationOptions,
     planner: Planner,
+    guard: UnknownGuard,
     window: ViewWindow,
     previous: Option<Frame>,
     path: Option<Vec<Point3<f64>>>,
     position: Point3<f64>,
     heading: Vector3<f64>,
+    pitch: f64,
     since_plan: usize,
     stalled: usize,
     frame_index: usize,
@@ -197,11 +207,13 @@ impl<'a> Flight<'a> {
                 max_range: Some(scenario.max_range.min(config.map_range)),
             },
             planner: Planner::new(map.as_map(), region, config.planner)?,
+            guard: UnknownGuard::new(),
             window: ViewWindow::new(config.views)?,
             previous: None,
             path: None,
             position: goal.start,
             heading: level(goal.goal - goal.start).unwrap_or_else(Vector3::x),
+            pitch: 0.0,
             since_plan: 0,
             stalled: 0,
             frame_index: 0,
@@ -229,6 +241,16 @@ impl<'a> Flight<'a> {
     /// Where the vehicle is.
     pub fn position(&self) -> Point3<f64> {
         self.position
+    }
+
+    /// The path the vehicle follows (its first point is the vehicle), if it has one.
+    pub fn path(&self) -> Option<&[Point3<f64>]> {
+        self.path.as_deref()
+    }
+
+    /// The direction the camera looked in at the last frame (level).
+    pub fn heading(&self) -> Vector3<f64> {
+        self.heading
     }
 
     /// The planner and its current cost field.
@@ -276,18 +298,33 @@ impl<'a> Flight<'a> {
         Ok(())
     }
 
-    /// The picture the camera takes now: level, towards the point ahead on the path (or the
-    /// goal), rendered from the true scene with the frame's noise.
+    /// The picture the camera takes now: towards the point ahead on the path (turning at
+    /// most [`FlyConfig::max_yaw_rate`], and pitching up or down as the path climbs or
+    /// descends, up to [`FlyConfig::max_pitch`]), rendered from the true scene with the frame's
+    /// noise.
     pub fn render(&mut self) -> Result<Frame> {
+        let turn = self.config.max_yaw_rate.to_radians() * self.config.frame_interval;
         if let Some(ahead) = self
             .path
             .as_deref()
             .map(|p| point_ahead(p, self.config.look_ahead))
-            && let Some(direction) = level(ahead - self.position)
         {
-            self.heading = direction;
+            let to = ahead - self.position;
+            if let Some(direction) = level(to) {
+                self.heading = turn_towards(self.heading, direction, turn);
+            }
+            let horizontal = to.x.hypot(to.y);
+            let wanted = if horizontal > 1e-6 || to.z.abs() > 1e-6 {
+                to.z.atan2(horizontal)
+            } else {
+                0.0
+            };
+            let limit = self.config.max_pitch.to_radians();
+            let wanted = wanted.clamp(-limit, limit);
+            self.pitch += (wanted - self.pitch).clamp(-turn, turn);
         }
-        let pose = look_at(self.position, self.heading);
+        let (sin, cos) = self.pitch.sin_cos();
+        let pose = look_at(self.position, self.heading * cos + Vector3::z() * sin);
         let noise = self
             .seed
             .wrapping_mul(1_000_003)
@@ -333,19 +370,31 @@ impl<'a> Flight<'a> {
         // otherwise plan again.
         let t = Instant::now();
         self.planner.update(map.as_map());
+        let updated = ms(t);
+        let t = Instant::now();
+        self.guard.update(
+            self.planner.field(),
+            &self.position,
+            self.config.unknown_guard,
+            self.config.guard_surface_reach,
+        );
+        times.guard_ms = ms(t);
+        let t = Instant::now();
+        let guard = &self.guard;
+        let avoid = |index: usize| guard.forbids(index);
         let keep = self.since_plan < self.config.replan_every
             && self
                 .path
                 .as_deref()
-                .is_some_and(|p| self.planner.is_clear(p));
+                .is_some_and(|p| self.planner.is_clear_avoiding(p, &avoid));
         if keep {
             self.since_plan += 1;
         } else {
-            self.path = replan(self.planner.field(), self.position, self.goal_key).ok();
+            self.path = replan(self.planner.field(), self.position, self.goal_key, &avoid).ok();
             self.log.replans += 1;
             self.since_plan = 0;
         }
-        times.update_replan_ms = ms(t);
+        times.update_replan_ms = updated + ms(t);
         self.log.cycles.push(times);
         Ok(times)
     }
@@ -356,15 +405,23 @@ impl<'a> Flight<'a> {
     fn fly(&mut self, map: &AnyMap) {
         let step = self.config.step();
         let position = self.position;
+        let weave = self.path.as_deref().and_then(|p| self.weave(p, step));
         let next = match self.path.as_mut() {
-            Some(current) if !current.is_empty() => {
+            Some(current) if current.len() >= 2 => {
                 self.stalled = 0;
-                advance(current, step)
+                match weave {
+                    Some(next) => {
+                        current[0] = next;
+                        next
+                    }
+                    None => advance(current, step),
+                }
             }
             _ => {
-                // No path: look at the goal and side-step left and right (when the map
-                // holds the step clear), so that the next frames see what blocks the way
-                // with a sideways baseline, stereo's best geometry.
+                // No path (or one that ends here): look at the goal and side-step left and
+                // right (when the map and the guard hold the step clear), so that the next
+                // frames see what blocks the way with a sideways baseline, stereo's best
+                // geometry.
                 self.stalled += 1;
                 if self.stalled >= STALL_FRAMES {
                     self.finish(Ending::NoPath);
@@ -373,7 +430,10 @@ impl<'a> Flight<'a> {
                 self.heading = level(self.goal.goal - position).unwrap_or(self.heading);
                 let sign = if self.stalled % 2 == 1 { 1.0 } else { -1.0 };
                 let next = position + self.heading.cross(&Vector3::z()) * sign * (0.6 * step);
-                if !self.planner.is_clear(&[position, next]) {
+                if !self
+                    .planner
+                    .is_clear_avoiding(&[position, next], &|i| self.guard.forbids(i))
+                {
                     return;
                 }
                 next
@@ -398,6 +458,35 @@ impl<'a> Flight<'a> {
         }
     }
 
+    /// The weaving step: `step` metres in the direction of the path's next waypoint turned by
+    /// [`FlyConfig::weave_angle`] to the left or right (the side changes every
+    /// [`FlyConfig::weave_frames`] frames), so that the point ahead never lies at the
+    /// epipole of the motion, where a moving camera measures no depth. `None` (fly straight)
+    /// when weaving is off, the path's next waypoint is within two steps, or the map does not
+    /// hold the weaving step and the leg from it to that waypoint clear.
+    fn weave(&self, path: &[Point3<f64>], step: f64) -> Option<Point3<f64>> {
+        let angle = self.config.weave_angle.to_radians();
+        let next_waypoint = *path.get(1)?;
+        let towards = next_waypoint - self.position;
+        if angle <= 0.0 || towards.norm() < 2.0 * step {
+            return None;
+        }
+        let direction = towards.normalize();
+        let side = if (self.frame_index / self.config.weave_frames).is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
+        let axis = nalgebra::Unit::new_normalize(Vector3::z());
+        let turned = nalgebra::Rotation3::from_axis_angle(&axis, side * angle) * direction;
+        let next = self.position + turned * step;
+        self.planner
+            .is_clear_avoiding(&[self.position, next, next_waypoint], &|i| {
+                self.guard.forbids(i)
+            })
+            .then_some(next)
+    }
+
     fn finish(&mut self, ending: Ending) {
         self.ending = Some(ending);
         self.log.ending = ending;
@@ -406,11 +495,13 @@ impl<'a> Flight<'a> {
 
 /// Plans through `field` from `position` to the goal. When the voxel the vehicle is in cannot
 /// be entered (the map learnt that something is near), plans from the nearest traversable
-/// voxel within half a metre instead.
+/// voxel within half a metre instead. Never enters a voxel `avoid` names (the start
+/// excepted).
 fn replan(
     field: &CostField,
     position: Point3<f64>,
     goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
 ) -> std::result::Result<Vec<Point3<f64>>, PlanError> {
     let resolution = field.resolution();
     let region = *field.region();
@@ -427,7 +518,7 @@ fn replan(
                         if best.is_none_or(|(b, _)| d2 < b)
                             && region
                                 .index_of(key)
-                                .is_some_and(|i| field.is_traversable(i))
+                                .is_some_and(|i| field.is_traversable(i) && !avoid(i))
                         {
                             best = Some((d2, key));
                         }
@@ -438,16 +529,16 @@ fn replan(
         }
         _ => here,
     };
-    let mut path = match plan_in_field(field, start, goal) {
+    let mut path = match plan_in_field_avoiding(field, start, goal, avoid) {
         // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
         // it (the known-safe frontier towards the goal), see more, and plan again there.
         Err(PlanError::GoalUnsafe(_) | PlanError::Disconnected { .. }) => {
-            let target = nearest_reachable(field, start, goal)
+            let target = nearest_reachable(field, start, goal, avoid)
                 .ok_or(PlanError::Disconnected { expanded: 0 })?;
             if resolution.center(target) == resolution.center(start) {
                 return Err(PlanError::Disconnected { expanded: 0 });
             }
-            plan_in_field(field, start, target)?
+            plan_in_field_avoiding(field, start, target, avoid)?
         }
         other => other?,
     };
@@ -459,8 +550,14 @@ fn replan(
 }
 
 /// The traversable voxel connected to `start` (through the field's 26-neighbourhood) nearest
-/// to `goal`, ties to the lowest index; `None` when `start` is not traversable.
-fn nearest_reachable(field: &CostField, start: VoxelKey, goal: VoxelKey) -> Option<VoxelKey> {
+/// to `goal` without entering a voxel `avoid` names, ties to the lowest index; `None` when
+/// `start` is not traversable.
+fn nearest_reachable(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
+) -> Option<VoxelKey> {
     let region = field.region();
     let first = region
         .index_of(start)
@@ -486,6 +583,7 @@ fn nearest_reachable(field: &CostField, start: VoxelKey, goal: VoxelKey) -> Opti
                     if let Some(n) = region.index_of(next)
                         && !seen[n]
                         && field.is_traversable(n)
+                        && !avoid(n)
                     {
                         seen[n] = true;
                         queue.push_back(n);
@@ -529,6 +627,19 @@ fn point_ahead(path: &[Point3<f64>], distance: f64) -> Point3<f64> {
     path.last().copied().unwrap_or(Point3::origin())
 }
 
+/// `from` turned about the vertical towards `to` (both level unit vectors) by at most `max`
+/// radians.
+fn turn_towards(from: Vector3<f64>, to: Vector3<f64>, max: f64) -> Vector3<f64> {
+    let angle = from.x.mul_add(to.y, -(from.y * to.x)).atan2(from.dot(&to));
+    let turn = angle.clamp(-max, max);
+    let (sin, cos) = turn.sin_cos();
+    Vector3::new(
+        from.x * cos - from.y * sin,
+        from.x * sin + from.y * cos,
+        0.0,
+    )
+}
+
 /// The horizontal part of `v`, normalised; `None` when it is (nearly) vertical.
 fn level(v: Vector3<f64>) -> Option<Vector3<f64>> {
     Vector3::new(v.x, v.y, 0.0).try_normalize(1e-6)
@@ -557,5 +668,20 @@ mod tests {
         let p = advance(&mut path, 5.0);
         assert_eq!(p, Point3::new(1.0, 2.0, 1.0));
         assert_eq!(point_ahead(&[Point3::origin()], 3.0), Point3::origin());
+    }
+
+    #[test]
+    fn the_camera_turns_at_most_its_rate() {
+        let (x, y) = (Vector3::x(), Vector3::y());
+        let max = 22.5f64.to_radians();
+        // A quarter turn to the left takes four frames, the first one 22.5° of it.
+        let first = turn_towards(x, y, max);
+        assert!((first.y.atan2(first.x) - max).abs() < 1e-12, "{first:?}");
+        // To the right as well; a small turn is made at once.
+        let right = turn_towards(x, -y, max);
+        assert!((right.y.atan2(right.x) + max).abs() < 1e-12, "{right:?}");
+        let small = Vector3::new(1.0, 0.1, 0.0).normalize();
+        assert!((turn_towards(x, small, max) - small).norm() < 1e-12);
+        assert!((turn_towards(x, x, max) - x).norm() < 1e-15);
     }
 }

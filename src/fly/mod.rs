@@ -6,6 +6,7 @@
 //!
 //! - [`config`]: the loop's parameters ([`FlyConfig`]);
 //! - [`goals`]: starts and goals in truly free space, and the true scene's path between them;
+//! - [`guard`]: no unseen space near the vehicle ([`UnknownGuard`]);
 //! - [`flight`]: one flight ([`fly_goal`]) and the prior map around the start;
 //! - [`report`]: the flights as JSON, figures and Markdown;
 //! - this module: every goal with every map ([`fly_all`]) and the summary per map.
@@ -13,6 +14,7 @@
 pub mod config;
 pub mod flight;
 pub mod goals;
+pub mod guard;
 pub mod report;
 
 use serde::Serialize;
@@ -20,6 +22,7 @@ use serde::Serialize;
 pub use config::FlyConfig;
 pub use flight::{CycleTimes, Ending, Flight, FlightLog, fly_goal, integrate_prior};
 pub use goals::{Goal, draw_goals, planning_region, truth_map};
+pub use guard::UnknownGuard;
 pub use report::{flight_figure, flights_json, flights_markdown, write_flight_figures};
 
 use crate::error::{Error, Result};
@@ -111,6 +114,10 @@ pub struct ModelSummary {
     pub update_replan_ms: f64,
     /// See `update_replan_ms`.
     pub update_replan_ms_p95: f64,
+    /// Updating the unseen-surface guard per cycle, milliseconds.
+    pub guard_ms: f64,
+    /// See `guard_ms`.
+    pub guard_ms_p95: f64,
     /// A full rebuild of the cost field over the planning region, timed on every tenth cycle,
     /// milliseconds.
     pub full_rebuild_ms: f64,
@@ -138,6 +145,7 @@ impl ModelFlights {
         let depth = times(|c| (c.depth_ms > 0.0).then_some(c.depth_ms));
         let integrate = times(|c| (c.integrate_ms > 0.0).then_some(c.integrate_ms));
         let replan = times(|c| Some(c.update_replan_ms));
+        let guard = times(|c| Some(c.guard_ms));
         let rebuild = times(|c| c.full_rebuild_ms);
         ModelSummary {
             goals: self.flights.len(),
@@ -161,6 +169,8 @@ impl ModelFlights {
             integrate_ms_p95: integrate[1],
             update_replan_ms: replan[0],
             update_replan_ms_p95: replan[1],
+            guard_ms: guard[0],
+            guard_ms_p95: guard[1],
             full_rebuild_ms: rebuild[0],
             full_rebuild_ms_p95: rebuild[1],
         }

@@ -107,6 +107,7 @@ impl FuzzyMap {
         let classify = |m: Memberships| measures.classify(m);
         self.grid.update_from(source, |block, source| {
             let mut updated = 0;
+            let mut changed = false;
             for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
                 let (o, e) = evidence_of(s);
                 if o <= 0.0 && e <= 0.0 {
@@ -119,11 +120,13 @@ impl FuzzyMap {
                 if e > 0.0 {
                     cell.free = operator.apply(cell.free, e);
                 }
+                changed |= cell.occupied.to_bits() != before.occupied.to_bits()
+                    || cell.free.to_bits() != before.free.to_bits();
                 // Keep the block's class counts current without reclassifying every cell.
                 block.summary.moved(classify(before), classify(*cell));
                 updated += 1;
             }
-            updated
+            (updated, changed)
         })
     }
 

@@ -147,9 +147,10 @@ impl CellUpdates {
     /// add then a clamp in single precision as OctoMap's `updateNodeLogOdds` does, and keeps the
     /// block's class counts current without reclassifying every cell.
     #[inline(always)]
-    fn apply(self, block: &mut Block<LogOdds>, i: usize, hits: u16, total: u16) {
+    /// Returns whether the cell changed.
+    fn apply(self, block: &mut Block<LogOdds>, i: usize, hits: u16, total: u16) -> bool {
         let Some(cell) = block.cells.get_mut(i) else {
-            return;
+            return false;
         };
         let before = *cell;
         let mut current = if before.is_observed() { before.0 } else { 0.0 };
@@ -162,6 +163,7 @@ impl CellUpdates {
         block
             .summary
             .moved(classify(before), classify(LogOdds(current)));
+        before.0.to_bits() != current.to_bits()
     }
 }
 
@@ -219,18 +221,18 @@ impl LogOddsMap {
         let updates = self.updates();
         self.grid
             .update_blocks(sets.blocks().collect(), |block, flags| {
-                let mut updated = 0;
+                let (mut updated, mut changed) = (0, false);
                 for word in 0..flags.passed.len() {
                     let mut marked = flags.passed[word] | flags.hit[word];
                     while marked != 0 {
                         let bit = marked.trailing_zeros() as usize;
                         marked &= marked - 1;
                         let hit = flags.hit[word] & (1 << bit) != 0;
-                        updates.apply(block, word * 64 + bit, u16::from(hit), 1);
+                        changed |= updates.apply(block, word * 64 + bit, u16::from(hit), 1);
                         updated += 1;
                     }
                 }
-                updated
+                (updated, changed)
             })
     }
 
@@ -244,15 +246,15 @@ impl LogOddsMap {
         let updates = self.updates();
         self.grid
             .update_blocks(levels.blocks().collect(), |block, marks| {
-                let mut updated = 0;
+                let (mut updated, mut changed) = (0, false);
                 for (i, (&passed, &hit)) in marks.passed.iter().zip(&marks.hit).enumerate() {
                     let cuts = passed.max(hit);
                     if cuts > 0 {
-                        updates.apply(block, i, hit, cuts);
+                        changed |= updates.apply(block, i, hit, cuts);
                         updated += usize::from(cuts);
                     }
                 }
-                updated
+                (updated, changed)
             })
     }
 

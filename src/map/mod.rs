@@ -70,10 +70,11 @@ pub trait VoxelMap: Send + Sync {
         None
     }
 
-    /// Keys of the blocks (8×8×8 voxels, [`VoxelKey::block`]) written after `version`, in
+    /// Keys of the blocks (8×8×8 voxels, [`VoxelKey::block`]) changed after `version`, in
     /// ascending order: every voxel whose memberships changed since the map's
-    /// [`write_version`](VoxelMap::write_version) was `version` lies in one of them. `None`
-    /// when the map does not track its writes.
+    /// [`write_version`](VoxelMap::write_version) was `version` lies in one of them (a block
+    /// an integration reached but left as it was need not be listed). `None` when the map does
+    /// not track its writes.
     fn changed_blocks_since(&self, _version: u64) -> Option<Vec<BlockKey>> {
         None
     }

@@ -123,6 +123,18 @@ pub fn plan_in_field(
     start: VoxelKey,
     goal: VoxelKey,
 ) -> Result<Path, PlanError> {
+    plan_in_field_avoiding(field, start, goal, &|_| false)
+}
+
+/// [`plan_in_field`] that also never enters a voxel (dense index) for which `avoid` is true,
+/// the start excepted: a caller's restriction on top of the field, such as the closed loop's
+/// guard that keeps the vehicle out of unseen space near it. Shortcuts obey it too.
+pub fn plan_in_field_avoiding(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
+) -> Result<Path, PlanError> {
     let region = field.region();
     let start_index = region
         .index_of(start)
@@ -175,7 +187,7 @@ pub fn plan_in_field(
         let g = best[node_index];
         for edge in graph.edges(node) {
             let target = edge.target() as usize;
-            if closed[target] {
+            if closed[target] || avoid(target) {
                 continue;
             }
             let candidate = g + *edge.weight();
@@ -197,7 +209,8 @@ pub fn plan_in_field(
         voxels.push(region.key_at(node));
     }
     voxels.reverse();
-    let corners = merge_collinear(field, &shortcut(field, &voxels));
+    let enter = |index: usize| field.is_traversable(index) && !avoid(index);
+    let corners = merge_collinear(field, &enter, &shortcut(field, &enter, &voxels));
     let resolution = field.resolution();
     let waypoints: Vec<Point3<f64>> = corners.iter().map(|k| resolution.center(*k)).collect();
     let length = waypoints.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -252,15 +265,17 @@ pub(super) fn segment_voxels(
 
 /// Greedy line-of-sight shortcutting: from each kept waypoint, jump to the farthest later
 /// voxel of the path whose straight segment crosses only traversable voxels.
-fn shortcut(field: &CostField, voxels: &[VoxelKey]) -> Vec<VoxelKey> {
+fn shortcut(
+    field: &CostField,
+    enter: &dyn Fn(usize) -> bool,
+    voxels: &[VoxelKey],
+) -> Vec<VoxelKey> {
     let mut kept = vec![voxels[0]];
     let mut anchor = 0;
     while anchor + 1 < voxels.len() {
         let mut next = anchor + 1;
         for candidate in (anchor + 2..voxels.len()).rev() {
-            if segment_voxels(field, voxels[anchor], voxels[candidate], |i| {
-                field.is_traversable(i)
-            }) {
+            if segment_voxels(field, voxels[anchor], voxels[candidate], enter) {
                 next = candidate;
                 break;
             }
@@ -279,15 +294,17 @@ fn shortcut(field: &CostField, voxels: &[VoxelKey]) -> Vec<VoxelKey> {
 /// the field's clearance guarantee. One within a thousandth of a voxel of it (possible only on
 /// segments over a thousand voxels long) is dropped when the merged segment crosses
 /// traversable voxels alone.
-fn merge_collinear(field: &CostField, corners: &[VoxelKey]) -> Vec<VoxelKey> {
+fn merge_collinear(
+    field: &CostField,
+    enter: &dyn Fn(usize) -> bool,
+    corners: &[VoxelKey],
+) -> Vec<VoxelKey> {
     let mut kept: Vec<VoxelKey> = Vec::with_capacity(corners.len());
     for (i, &key) in corners.iter().enumerate() {
         let redundant = match (kept.last(), corners.get(i + 1)) {
             (Some(&before), Some(&after)) => match offset_from_segment(before, key, after) {
                 Some(0.0) => true,
-                Some(offset) if offset <= 1e-3 => {
-                    segment_voxels(field, before, after, |i| field.is_traversable(i))
-                }
+                Some(offset) if offset <= 1e-3 => segment_voxels(field, before, after, enter),
                 _ => false,
             },
             _ => false,
@@ -362,6 +379,10 @@ mod tests {
         CostField::build(&map, region, config).unwrap()
     }
 
+    fn traversable(field: &CostField) -> impl Fn(usize) -> bool + '_ {
+        |index| field.is_traversable(index)
+    }
+
     fn keys(points: &[[i32; 3]]) -> Vec<VoxelKey> {
         points
             .iter()
@@ -382,12 +403,16 @@ mod tests {
             [10, 30, 10],
         ]);
         assert_eq!(
-            merge_collinear(&field, &corners),
+            merge_collinear(&field, &traversable(&field), &corners),
             keys(&[[5, 5, 5], [10, 10, 5], [10, 30, 5], [10, 30, 10]])
         );
         // A repeated point is redundant too.
         assert_eq!(
-            merge_collinear(&field, &keys(&[[5, 5, 5], [5, 5, 5], [9, 5, 5]])),
+            merge_collinear(
+                &field,
+                &traversable(&field),
+                &keys(&[[5, 5, 5], [5, 5, 5], [9, 5, 5]])
+            ),
             keys(&[[5, 5, 5], [9, 5, 5]])
         );
     }
@@ -397,14 +422,23 @@ mod tests {
         let field = open_field(false);
         // Off the line by one voxel: a real corner.
         let corner = keys(&[[5, 5, 5], [10, 6, 5], [15, 5, 5]]);
-        assert_eq!(merge_collinear(&field, &corner), corner);
+        assert_eq!(
+            merge_collinear(&field, &traversable(&field), &corner),
+            corner
+        );
         // On the line but beyond its end: dropping it would cut the path short.
         let reversal = keys(&[[5, 5, 5], [15, 5, 5], [10, 5, 5]]);
-        assert_eq!(merge_collinear(&field, &reversal), reversal);
+        assert_eq!(
+            merge_collinear(&field, &traversable(&field), &reversal),
+            reversal
+        );
         // Ends alone, and a single point, are left as they are.
         let two = keys(&[[5, 5, 5], [15, 5, 5]]);
-        assert_eq!(merge_collinear(&field, &two), two);
-        assert_eq!(merge_collinear(&field, &two[..1]), two[..1]);
+        assert_eq!(merge_collinear(&field, &traversable(&field), &two), two);
+        assert_eq!(
+            merge_collinear(&field, &traversable(&field), &two[..1]),
+            two[..1]
+        );
     }
 
     #[test]

@@ -29,7 +29,7 @@ mod graph;
 mod planner;
 mod queries;
 
-pub use astar::{Path, PlanError, plan_in_field, plan_path};
+pub use astar::{Path, PlanError, plan_in_field, plan_in_field_avoiding, plan_path};
 pub use blocker::{Blocker, NearestBlocked, ObservedExtent};
 pub use config::{PlannerConfig, UnknownPolicy};
 pub use cost_field::{CostField, PlanningRegion, is_blocked};

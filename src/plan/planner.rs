@@ -96,6 +96,16 @@ impl Planner {
     /// current field (the test the planner's own shortcuts pass), so that a path planned
     /// earlier can be kept while the map grows.
     pub fn is_clear(&self, waypoints: &[Point3<f64>]) -> bool {
+        self.is_clear_avoiding(waypoints, &|_| false)
+    }
+
+    /// [`is_clear`](Planner::is_clear) that also refuses every voxel (dense index) for which
+    /// `avoid` is true, the first waypoint's voxel excepted (the vehicle is there already).
+    pub fn is_clear_avoiding(
+        &self,
+        waypoints: &[Point3<f64>],
+        avoid: &dyn Fn(usize) -> bool,
+    ) -> bool {
         let resolution = self.field.resolution();
         let keys: Option<Vec<VoxelKey>> = waypoints
             .iter()
@@ -104,18 +114,16 @@ impl Planner {
         let Some(keys) = keys else {
             return false;
         };
+        let region = self.field.region();
+        let Some(first) = keys.first().and_then(|k| region.index_of(*k)) else {
+            return false;
+        };
+        let enter = |i: usize| self.field.is_traversable(i) && (i == first || !avoid(i));
         match keys.as_slice() {
-            [] => false,
-            [only] => self
-                .field
-                .region()
-                .index_of(*only)
-                .is_some_and(|i| self.field.is_traversable(i)),
-            _ => keys.windows(2).all(|leg| {
-                segment_voxels(&self.field, leg[0], leg[1], |i| {
-                    self.field.is_traversable(i)
-                })
-            }),
+            [_] => enter(first),
+            _ => keys
+                .windows(2)
+                .all(|leg| segment_voxels(&self.field, leg[0], leg[1], enter)),
         }
     }
 }

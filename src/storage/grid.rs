@@ -275,11 +275,12 @@ impl<C: Copy + Default> BlockGrid<C> {
 
     /// Updates every block that has a counterpart in `source` with `update(block, source_block)`,
     /// in parallel, each block by one thread (so the result does not depend on the thread
-    /// count). Missing blocks are allocated first. Returns the sum of what `update` returns.
+    /// count). Missing blocks are allocated first. `update` returns a count and whether it
+    /// changed the block; returns the sum of the counts.
     pub fn update_from<S: Copy + Default + Sync>(
         &mut self,
         source: &BlockGrid<S>,
-        update: impl Fn(&mut Block<C>, &Block<S>) -> usize + Sync,
+        update: impl Fn(&mut Block<C>, &Block<S>) -> (usize, bool) + Sync,
     ) -> usize
     where
         C: Send + Sync,
@@ -289,12 +290,15 @@ impl<C: Copy + Default> BlockGrid<C> {
 
     /// Like [`BlockGrid::update_from`] for any per-block payload: `sources` pairs block keys
     /// with what each block is updated from. Missing blocks are allocated in key order, so
-    /// the storage order does not depend on the order of `sources`. Every block with a source
-    /// counts as written.
+    /// the storage order does not depend on the order of `sources`. `update` returns a count
+    /// and whether it changed the block: a block counts as written when it changed or was
+    /// allocated, so that consumers of [`changed_since`](BlockGrid::changed_since) skip blocks
+    /// whose cells a scan left as they were (repeated evidence at a bound, say). Returns the
+    /// sum of the counts.
     pub fn update_blocks<S: Sync>(
         &mut self,
         mut sources: Vec<(BlockKey, &S)>,
-        update: impl Fn(&mut Block<C>, &S) -> usize + Sync,
+        update: impl Fn(&mut Block<C>, &S) -> (usize, bool) + Sync,
     ) -> usize
     where
         C: Send + Sync,
@@ -315,14 +319,22 @@ impl<C: Copy + Default> BlockGrid<C> {
         for (key, source) in sources {
             if let Some(position) = self.position(key) {
                 by_position[position] = Some(source);
+            }
+        }
+        let results: Vec<(usize, bool)> = self
+            .blocks
+            .par_iter_mut()
+            .zip(by_position.par_iter())
+            .map(|(block, source)| source.map_or((0, false), |s| update(block, s)))
+            .collect();
+        let mut total = 0;
+        for (position, (count, changed)) in results.into_iter().enumerate() {
+            total += count;
+            if changed {
                 self.mark(position);
             }
         }
-        self.blocks
-            .par_iter_mut()
-            .zip(by_position.par_iter())
-            .map(|(block, source)| source.map_or(0, |s| update(block, s)))
-            .sum()
+        total
     }
 
     /// Heap memory held by the grid, in bytes (blocks, key list and hash index).
@@ -408,14 +420,21 @@ mod tests {
         assert_eq!(grid.changed_since(start), vec![a]);
         let after_first = grid.version();
         assert!(grid.changed_since(after_first).is_empty());
-        // A batch update marks the blocks it had a source for, allocated or not.
+        // A batch update marks the blocks it allocated or changed, not those it left alone.
         let source = 7u8;
-        grid.update_blocks(vec![(b, &source)], |block, s| {
+        let write = |block: &mut crate::storage::Block<u8>, s: &u8| {
+            let changed = block.cells[0] != *s;
             block.cells[0] = *s;
-            1
-        });
+            (1, changed)
+        };
+        grid.update_blocks(vec![(b, &source)], write);
         assert_eq!(grid.changed_since(after_first), vec![b]);
         assert_eq!(grid.changed_since(start), vec![a, b]);
+        let unchanged = grid.version();
+        grid.update_blocks(vec![(b, &source)], write);
+        assert!(grid.changed_since(unchanged).is_empty());
+        grid.update_blocks(vec![(b, &9)], write);
+        assert_eq!(grid.changed_since(unchanged), vec![b]);
         // Reads leave the version alone; every write path advances it.
         let read = grid.version();
         let _ = grid.cell(VoxelKey::new(0, 0, 0));

@@ -1,0 +1,226 @@
+//! The unseen-surface guard: the loop does not fly through the parts of a surface its map has
+//! not seen yet.
+//!
+//! Unknown space may be crossed at a cost (goals lie in space nobody has seen), and most of it
+//! is empty. Unknown space next to a surface the map has begun to see is different: it is
+//! usually the rest of that surface, seen too obliquely, too close or at the epipole of the
+//! camera's motion (where depth from motion is undefined). The guard forbids, within
+//! [`FlyConfig::unknown_guard`](super::FlyConfig::unknown_guard) metres of the vehicle, every
+//! unknown voxel within
+//! [`FlyConfig::guard_surface_reach`](super::FlyConfig::guard_surface_reach) of an occupied or
+//! ambiguous voxel ("suspect" voxels), and every voxel within the vehicle's radius of one.
+//! Suspects are remembered until the map learns what they are, so that the forbidden set does
+//! not move with the vehicle (a set that moves makes paths flip from one frame to the next).
+
+use nalgebra::Point3;
+use rustc_hash::FxHashSet;
+
+use crate::measures::VoxelClass;
+use crate::plan::CostField;
+
+/// The suspect voxels of one flight and the voxels they forbid, over the field's region.
+#[derive(Clone, Debug, Default)]
+pub struct UnknownGuard {
+    /// Dense indices of the suspect voxels.
+    suspects: FxHashSet<usize>,
+    /// Per dense index: forbidden (a suspect within the vehicle's radius).
+    forbidden: Vec<bool>,
+    /// The indices set in `forbidden`, to clear them.
+    marked: Vec<usize>,
+}
+
+impl UnknownGuard {
+    /// A guard that forbids nothing yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds the suspects within `radius` metres of `position`, drops the suspects the map no
+    /// longer holds unknown, and recomputes what they forbid.
+    pub fn update(
+        &mut self,
+        field: &CostField,
+        position: &Point3<f64>,
+        radius: f64,
+        surface_reach: f64,
+    ) {
+        let region = *field.region();
+        let dims = region.dims();
+        let size = field.resolution().size();
+        if radius > 0.0
+            && let Ok(here) = field.resolution().key_of(position)
+            && region.index_of(here).is_some()
+        {
+            let min = region.min();
+            let centre = [
+                i64::from(here.x) - i64::from(min.x),
+                i64::from(here.y) - i64::from(min.y),
+                i64::from(here.z) - i64::from(min.z),
+            ];
+            self.add_suspects(field, centre, radius / size, surface_reach / size);
+        }
+        self.suspects
+            .retain(|&index| field.class(index) == VoxelClass::Unknown);
+
+        for &index in &self.marked {
+            self.forbidden[index] = false;
+        }
+        self.marked.clear();
+        self.forbidden.resize(region.len(), false);
+        let pad = (field.config().vehicle_radius / size).ceil() as i64;
+        let near = (field.config().vehicle_radius / size).powi(2) + 1e-9;
+        let mut suspects: Vec<usize> = self.suspects.iter().copied().collect();
+        suspects.sort_unstable();
+        for index in suspects {
+            let u = coordinates(index, dims);
+            for z in (u[2] - pad).max(0)..=(u[2] + pad).min(dims[2] as i64 - 1) {
+                for y in (u[1] - pad).max(0)..=(u[1] + pad).min(dims[1] as i64 - 1) {
+                    for x in (u[0] - pad).max(0)..=(u[0] + pad).min(dims[0] as i64 - 1) {
+                        let c = [x, y, z];
+                        if squared(c, u) <= near {
+                            let i = dense(c, dims);
+                            if !self.forbidden[i] {
+                                self.forbidden[i] = true;
+                                self.marked.push(i);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Unknown voxels within `reach` voxels of an occupied or ambiguous voxel, within
+    /// `radius` voxels of `centre` (region coordinates).
+    fn add_suspects(&mut self, field: &CostField, centre: [i64; 3], radius: f64, reach: f64) {
+        let dims = field.region().dims();
+        let r = radius.ceil() as i64;
+        let lo: [i64; 3] = std::array::from_fn(|a| (centre[a] - r).max(0));
+        let hi: [i64; 3] = std::array::from_fn(|a| (centre[a] + r).min(dims[a] as i64 - 1));
+        let s = reach.floor() as i64;
+        let within = reach * reach + 1e-9;
+        let ball = radius * radius + 1e-9;
+        for z in (lo[2] - s).max(0)..=(hi[2] + s).min(dims[2] as i64 - 1) {
+            for y in (lo[1] - s).max(0)..=(hi[1] + s).min(dims[1] as i64 - 1) {
+                for x in (lo[0] - s).max(0)..=(hi[0] + s).min(dims[0] as i64 - 1) {
+                    let surface = [x, y, z];
+                    if !matches!(
+                        field.class(dense(surface, dims)),
+                        VoxelClass::Occupied | VoxelClass::Ambiguous
+                    ) {
+                        continue;
+                    }
+                    for sz in (z - s).max(lo[2])..=(z + s).min(hi[2]) {
+                        for sy in (y - s).max(lo[1])..=(y + s).min(hi[1]) {
+                            for sx in (x - s).max(lo[0])..=(x + s).min(hi[0]) {
+                                let c = [sx, sy, sz];
+                                if squared(c, surface) <= within && squared(c, centre) <= ball {
+                                    let i = dense(c, dims);
+                                    if field.class(i) == VoxelClass::Unknown {
+                                        self.suspects.insert(i);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether the voxel at a dense index of the field's region is forbidden.
+    pub fn forbids(&self, index: usize) -> bool {
+        self.forbidden.get(index).copied().unwrap_or(false)
+    }
+
+    /// Number of suspect voxels.
+    pub fn suspects(&self) -> usize {
+        self.suspects.len()
+    }
+}
+
+fn coordinates(index: usize, dims: [usize; 3]) -> [i64; 3] {
+    [
+        (index % dims[0]) as i64,
+        ((index / dims[0]) % dims[1]) as i64,
+        (index / (dims[0] * dims[1])) as i64,
+    ]
+}
+
+fn dense(c: [i64; 3], dims: [usize; 3]) -> usize {
+    c[0] as usize + dims[0] * (c[1] as usize + dims[1] * c[2] as usize)
+}
+
+fn squared(a: [i64; 3], b: [i64; 3]) -> f64 {
+    (0..3).map(|i| ((a[i] - b[i]) as f64).powi(2)).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::FunctionMap;
+    use crate::measures::Memberships;
+    use crate::plan::{PlannerConfig, PlanningRegion, UnknownPolicy};
+    use crate::storage::{Resolution, VoxelKey};
+
+    /// A 6 × 6 × 2 m box at 0.2 m: free everywhere, but a wall at x = 15 (occupied for
+    /// y < 15, unknown beyond: the part not seen yet) and a patch of unknown space far from
+    /// it at x = 3; with `seen`, the wall's unknown part has been seen free.
+    fn wall_field(seen: bool) -> CostField {
+        let resolution = Resolution::new(0.2).unwrap();
+        let map = FunctionMap::new(resolution, move |key| {
+            let free = Memberships {
+                occupied: 0.0,
+                free: 0.95,
+            };
+            let unknown = Memberships::default();
+            if key.x == 15 && key.y < 15 {
+                Memberships {
+                    occupied: 0.95,
+                    free: 0.0,
+                }
+            } else if (key.x == 15 && !seen) || (key.x == 3 && (10..20).contains(&key.y)) {
+                unknown
+            } else {
+                free
+            }
+        });
+        let region = PlanningRegion::new(VoxelKey::new(0, 0, 0), VoxelKey::new(29, 29, 9)).unwrap();
+        let config = PlannerConfig {
+            unknown: UnknownPolicy::Cost(2.0),
+            ..PlannerConfig::default()
+        };
+        CostField::build(&map, region, config).unwrap()
+    }
+
+    #[test]
+    fn unknown_next_to_a_surface_is_forbidden_and_remembered() {
+        let field = wall_field(false);
+        let region = *field.region();
+        let index = |x, y, z| region.index_of(VoxelKey::new(x, y, z)).unwrap();
+        let centre = |x, y, z| field.resolution().center(VoxelKey::new(x, y, z));
+        let mut guard = UnknownGuard::new();
+        guard.update(&field, &centre(12, 15, 5), 2.0, 0.6);
+        // The wall's unknown continuation, and voxels within the vehicle's radius of it.
+        assert!(guard.forbids(index(15, 16, 5)));
+        assert!(guard.forbids(index(14, 16, 5)));
+        assert!(!guard.forbids(index(13, 16, 5)));
+        // Beyond the surface reach (3 voxels from the last occupied one at y = 14).
+        assert!(!guard.forbids(index(15, 20, 5)));
+        // Unknown space far from any surface is left to the planner's policy.
+        assert!(!guard.forbids(index(3, 15, 5)));
+        assert!(guard.suspects() > 0);
+        // Remembered when the vehicle has moved away...
+        guard.update(&field, &centre(3, 3, 5), 2.0, 0.6);
+        assert!(guard.forbids(index(15, 16, 5)));
+        // ...until the map has seen what the suspects are.
+        guard.update(&wall_field(true), &centre(3, 3, 5), 2.0, 0.6);
+        assert_eq!(guard.suspects(), 0);
+        assert!(!guard.forbids(index(15, 16, 5)));
+        // A radius of 0 adds nothing; a fresh guard forbids nothing.
+        let mut off = UnknownGuard::new();
+        off.update(&field, &centre(12, 15, 5), 0.0, 0.6);
+        assert_eq!(off.suspects(), 0);
+        assert!(!UnknownGuard::new().forbids(index(15, 16, 5)));
+    }
+}
