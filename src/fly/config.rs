@@ -41,15 +41,16 @@ pub struct FlyConfig {
     pub look_ahead: f64,
     /// The camera turns (yaws) at most this fast, degrees per second, so that consecutive
     /// frames overlap and the depth stage can match them even when the path turns sharply.
-    /// Default 90 (22.5° per frame at the default frame interval).
+    /// Default 720 (180° per frame at the default frame interval: no limit).
     pub max_yaw_rate: f64,
     /// The camera pitches towards the point ahead when the path climbs or descends, at most
-    /// this many degrees up or down (turning at the yaw rate's limit). Default 40.
+    /// this many degrees up or down (turning at the yaw rate's limit). Default 0 (a level
+    /// camera).
     pub max_pitch: f64,
     /// The vehicle weaves: each step leaves the direction of the path's next waypoint by this
     /// angle, degrees, to the left and then to the right, so that what lies straight ahead on
     /// the path is never at the epipole of the camera's motion (where depth from motion is
-    /// undefined). 0 flies straight. Default 25.
+    /// undefined). 0 flies straight. Default 0.
     pub weave_angle: f64,
     /// Frames between changes of the weaving side. Default 2.
     pub weave_frames: usize,
@@ -59,7 +60,7 @@ pub struct FlyConfig {
     /// The unseen-surface guard collects, within this distance of the vehicle, metres, the
     /// unknown voxels next to surfaces the map has seen, and the planner neither enters them
     /// nor passes within the vehicle's radius of them, whatever the unknown-space policy: see
-    /// [`UnknownGuard`](super::guard::UnknownGuard). 0 turns the guard off. Default 5.
+    /// [`UnknownGuard`](super::guard::UnknownGuard). 0 turns the guard off. Default 0 (off).
     pub unknown_guard: f64,
     /// The guard forbids only unknown voxels within this distance of an occupied or ambiguous
     /// voxel, metres: the unseen parts of surfaces the map has begun to see. Default 0.6.
@@ -92,12 +93,12 @@ impl Default for FlyConfig {
             },
             prior_radius: 2.0,
             look_ahead: 3.0,
-            max_yaw_rate: 90.0,
-            weave_angle: 25.0,
-            max_pitch: 40.0,
+            max_yaw_rate: 720.0,
+            weave_angle: 0.0,
+            max_pitch: 0.0,
             weave_frames: 2,
             replan_every: 8,
-            unknown_guard: 5.0,
+            unknown_guard: 0.0,
             guard_surface_reach: 0.6,
             region_margin: 6.0,
             altitude: (1.5, 6.0),

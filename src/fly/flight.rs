@@ -11,7 +11,6 @@ use super::goals::{Goal, planning_region};
 use super::guard::UnknownGuard;
 use crate::depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
 use crate::error::Result;
-use crate::geometry::PinholeIntrinsics;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
 use crate::map::AnyMap;
 use crate::plan::{CostField, PlanError, Planner, plan_in_field_avoiding};
@@ -84,8 +83,7 @@ pub struct FlightLog {
 }
 
 /// The prior map: what the vehicle knows of its surroundings before take-off. Six true depth
-/// images from the start, the faces of a cube (four level directions, up and down, each with a
-/// 90° field of view, so that together they see every direction), cut at the prior radius: the
+/// images from the start (four level directions, up and down), cut at the prior radius: the
 /// surfaces within it and the free space in front of them, with full confidence.
 pub fn integrate_prior(
     scenario: &Scenario,
@@ -98,18 +96,15 @@ pub fn integrate_prior(
         Vector3::y(),
         -Vector3::x(),
         -Vector3::y(),
-        Vector3::new(1e-6, 0.0, 1.0),
-        Vector3::new(1e-6, 0.0, -1.0),
+        Vector3::new(0.01, 0.0, 1.0),
+        Vector3::new(0.01, 0.0, -1.0),
     ];
-    // A cube face: 90° across, a little wider so that neighbouring faces overlap.
-    let side = 128;
-    let half = f64::from(side) / 2.0;
-    let k = PinholeIntrinsics::new(side, side, half * 0.95, half * 0.95, half - 0.5, half - 0.5)?;
     let options = IntegrationOptions {
         max_range: Some(config.prior_radius),
     };
     for direction in directions {
         let pose = look_at(*start, direction);
+        let k = scenario.intrinsics;
         let view = render(&scenario.scene, &k, &pose, 0, scenario.max_range * 4.0);
         // Sky: far away, so that the ray clears free space up to the prior radius.
         let far = (scenario.max_range * 4.0) as f32;
@@ -407,7 +402,7 @@ impl<'a> Flight<'a> {
         let position = self.position;
         let weave = self.path.as_deref().and_then(|p| self.weave(p, step));
         let next = match self.path.as_mut() {
-            Some(current) if current.len() >= 2 => {
+            Some(current) if !current.is_empty() => {
                 self.stalled = 0;
                 match weave {
                     Some(next) => {
@@ -418,7 +413,7 @@ impl<'a> Flight<'a> {
                 }
             }
             _ => {
-                // No path (or one that ends here): look at the goal and side-step left and
+                // No path: look at the goal and side-step left and
                 // right (when the map and the guard hold the step clear), so that the next
                 // frames see what blocks the way with a sideways baseline, stereo's best
                 // geometry.
@@ -628,9 +623,12 @@ fn point_ahead(path: &[Point3<f64>], distance: f64) -> Point3<f64> {
 }
 
 /// `from` turned about the vertical towards `to` (both level unit vectors) by at most `max`
-/// radians.
+/// radians (`to` itself when it is that near).
 fn turn_towards(from: Vector3<f64>, to: Vector3<f64>, max: f64) -> Vector3<f64> {
     let angle = from.x.mul_add(to.y, -(from.y * to.x)).atan2(from.dot(&to));
+    if angle.abs() <= max {
+        return to;
+    }
     let turn = angle.clamp(-max, max);
     let (sin, cos) = turn.sin_cos();
     Vector3::new(
