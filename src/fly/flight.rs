@@ -413,10 +413,9 @@ impl<'a> Flight<'a> {
                 }
             }
             _ => {
-                // No path: look at the goal and side-step left and
-                // right (when the map and the guard hold the step clear), so that the next
-                // frames see what blocks the way with a sideways baseline, stereo's best
-                // geometry.
+                // No path: look at the goal and side-step left and right (when the map and
+                // the guard hold the step clear), so that the next frames see what blocks the
+                // way with a sideways baseline, stereo's best geometry.
                 self.stalled += 1;
                 if self.stalled >= STALL_FRAMES {
                     self.finish(Ending::NoPath);

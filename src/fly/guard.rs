@@ -44,6 +44,10 @@ impl UnknownGuard {
         radius: f64,
         surface_reach: f64,
     ) {
+        if radius <= 0.0 && self.suspects.is_empty() && self.marked.is_empty() {
+            // Off, and nothing left from before: nothing to forbid.
+            return;
+        }
         let region = *field.region();
         let dims = region.dims();
         let size = field.resolution().size();
