@@ -7,7 +7,9 @@
 //! each depth measurement over the frustum and interval it really covers, and derives
 //! ambiguity, indeterminacy, safety and a class for every voxel.
 //!
-//! The parts, each usable on its own:
+//! This crate is the facade: it re-exports the workspace's crates under one name and holds the
+//! `fuzzyvox` command (behind the default `cli` feature). The parts, each a crate usable on its
+//! own (see `docs/architecture.md`):
 //! - [`ops`]: t-norms, t-conorms, complements and hedges;
 //! - storage: sparse 8×8×8 blocks with `i32` keys ([`BlockGrid`], [`Resolution`]);
 //! - integration of [`PointCloud`]s (exact ray walk) and [`DepthFrame`]s with depth intervals
@@ -32,46 +34,21 @@
 
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
+pub use fuzzyvox_core::{class, error, file, geometry, integrate, map, measures, ops, storage};
+pub use fuzzyvox_depth as depth;
+pub use fuzzyvox_eval as eval;
+pub use fuzzyvox_figure as figure;
+pub use fuzzyvox_fly as fly;
+pub use fuzzyvox_io as io;
+pub use fuzzyvox_plan as plan;
+pub use fuzzyvox_sim as sim;
+pub use fuzzyvox_view as view;
 
-pub mod depth;
-mod error;
-pub mod eval;
-pub mod figure;
-pub mod fly;
-pub mod geometry;
-pub mod integrate;
-pub mod io;
-pub mod map;
-pub mod measures;
-pub mod ops;
-pub mod plan;
-pub mod sim;
-pub mod storage;
-pub mod view;
-
-pub use error::{Error, FormatError, Result};
-pub use geometry::{PinholeIntrinsics, pose_from_matrix, validate_pose};
-pub use integrate::{
-    DepthFrame, Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats,
-    IntervalDepthImage, PointCloud, ScanEvidence,
+pub use fuzzyvox_core::{
+    AlphaConfig, AlphaCutMap, AnyMap, BlockGrid, BlockKey, ClassThresholds, Complement, DepthFrame,
+    Error, Evidence, EvidenceKind, EvidenceModel, Family, FormatError, FuzzyConfig, FuzzyMap,
+    Hedge, IntegrationOptions, IntegrationStats, IntervalDepthImage, KeyBox, LogOddsConfig,
+    LogOddsMap, MeasureConfig, Measures, Memberships, PinholeIntrinsics, PointCloud, Resolution,
+    Result, ScanEvidence, TConorm, TNorm, VoxelClass, VoxelCounts, VoxelKey, VoxelMap, VoxelMapMut,
+    pose_from_matrix, validate_pose,
 };
-pub use map::{
-    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
-    VoxelCounts, VoxelMap, VoxelMapMut,
-};
-pub use measures::{ClassThresholds, MeasureConfig, Measures, Memberships, VoxelClass};
-pub use ops::{Complement, Family, Hedge, TConorm, TNorm};
-pub use storage::{BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};

@@ -396,7 +396,7 @@ fn a_camera_outside_the_key_range_is_an_error_in_every_map() {
 
 /// Integrates a frame whose pixels all lie at 3 m (interval 2.98–3.03 m), seen by a skewed
 /// camera, into a new fuzzy map at 0.05 m. The five-second bound (the work takes about 12 ms)
-/// only guards against a hang; the culling test in `src/integrate/frustum.rs` checks how many
+/// only guards against a hang; the culling test in `crates/fuzzyvox-core/src/integrate/frustum.rs` checks how many
 /// blocks such frustums keep.
 fn integrate_skewed(
     k: PinholeIntrinsics,

@@ -115,7 +115,11 @@ pub fn wall_frame(position: Point3<f64>, wall_x: f64) -> DepthFrame {
 
 /// Runs the `fuzzyvox` binary built for these tests with `args`.
 pub fn fuzzyvox(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fuzzyvox"))
+    // Built only with the `cli` feature (on by default); the tests that call this require it.
+    let Some(exe) = option_env!("CARGO_BIN_EXE_fuzzyvox") else {
+        panic!("the command-line tests need the `cli` feature");
+    };
+    Command::new(exe)
         .args(args)
         .output()
         .expect("running fuzzyvox")

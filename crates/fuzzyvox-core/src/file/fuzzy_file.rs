@@ -1,0 +1,163 @@
+use serde::{Deserialize, Serialize};
+
+use super::mapfile::{self, MapKind};
+use super::stored_blocks::{self, StoredBlock};
+use crate::error::{FormatError, Result};
+use crate::integrate::EvidenceModel;
+use crate::map::{FuzzyConfig, FuzzyMap};
+use crate::measures::{MeasureConfig, Memberships};
+use crate::ops::TConorm;
+use crate::storage::Resolution;
+
+#[derive(Serialize, Deserialize)]
+struct Body {
+    config: FuzzyConfig,
+    blocks: Vec<StoredBlock<Memberships>>,
+}
+
+/// A format version 1 body: its evidence model had no kind (it was the paper's model) and no
+/// free reach.
+#[derive(Serialize, Deserialize)]
+struct BodyV1 {
+    config: ConfigV1,
+    blocks: Vec<StoredBlock<Memberships>>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct ConfigV1 {
+    resolution: Resolution,
+    operator: TConorm,
+    evidence: EvidenceV1,
+    measures: MeasureConfig,
+}
+
+#[derive(Serialize, Deserialize)]
+struct EvidenceV1 {
+    occupied_gain: f32,
+    free_gain: f32,
+    angular_resolution: f64,
+    interval_falloff: f32,
+}
+
+impl From<BodyV1> for Body {
+    fn from(old: BodyV1) -> Self {
+        let e = old.config.evidence;
+        Body {
+            config: FuzzyConfig {
+                resolution: old.config.resolution,
+                operator: old.config.operator,
+                evidence: EvidenceModel {
+                    occupied_gain: e.occupied_gain,
+                    free_gain: e.free_gain,
+                    angular_resolution: e.angular_resolution,
+                    interval_falloff: e.interval_falloff,
+                    ..EvidenceModel::paper()
+                },
+                measures: old.config.measures,
+            },
+            blocks: old.blocks,
+        }
+    }
+}
+
+mapfile::native_file_methods!(FuzzyMap);
+
+impl FuzzyMap {
+    /// The map as the bytes of a native map file. Blocks are written in key order, so equal
+    /// maps give equal bytes however they were built.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let config = *self.config();
+        mapfile::encode(
+            MapKind::Fuzzy,
+            Some(config.operator.family()),
+            config.resolution.size(),
+            &Body {
+                config,
+                blocks: stored_blocks::store(self.grid()),
+            },
+        )
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, FormatError> {
+        let (header, body) = mapfile::body_of(bytes, MapKind::Fuzzy)?;
+        let invalid = FormatError::Invalid;
+        let body: Body = if header.version == 1 {
+            postcard::from_bytes::<BodyV1>(body)
+                .map_err(|e| invalid(e.to_string()))?
+                .into()
+        } else {
+            postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?
+        };
+        let config = body.config.validate().map_err(|e| invalid(e.to_string()))?;
+        if header.resolution != config.resolution.size()
+            || header.operator != Some(config.operator.family())
+        {
+            return Err(invalid("header and body disagree".into()));
+        }
+        let unit = |v: f32| (0.0..=1.0).contains(&v);
+        let grid = stored_blocks::restore(body.blocks, |m: &Memberships| {
+            unit(m.occupied) && unit(m.free)
+        })?;
+        Ok(FuzzyMap::from_parts(config, grid))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::EvidenceKind;
+
+    /// A version 1 file (written before the evidence model had a kind) loads with the paper's
+    /// model, its memberships intact.
+    #[test]
+    fn version_1_files_load_with_the_papers_model() {
+        let config = FuzzyConfig::new(0.25).unwrap();
+        let mut map = FuzzyMap::new(config).unwrap();
+        let cloud = crate::integrate::PointCloud::new(
+            nalgebra::Point3::origin(),
+            vec![nalgebra::Point3::new(1.0, 0.5, 0.0)],
+        )
+        .unwrap();
+        crate::map::VoxelMapMut::integrate_cloud(&mut map, &cloud, &Default::default()).unwrap();
+        let old = BodyV1 {
+            config: ConfigV1 {
+                resolution: config.resolution,
+                operator: config.operator,
+                evidence: EvidenceV1 {
+                    occupied_gain: 0.7,
+                    free_gain: 0.6,
+                    angular_resolution: 0.002,
+                    interval_falloff: 1.0,
+                },
+                measures: config.measures,
+            },
+            blocks: stored_blocks::store(map.grid()),
+        };
+        let mut bytes = mapfile::encode(MapKind::Fuzzy, Some(config.operator.family()), 0.25, &old);
+        // Rewrite the header as version 1 and fix the checksum.
+        bytes[8..10].copy_from_slice(&1u16.to_le_bytes());
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(&bytes[..36]);
+        crc.update(&bytes[40..]);
+        let sum = crc.finalize().to_le_bytes();
+        bytes[36..40].copy_from_slice(&sum);
+        let loaded = FuzzyMap::decode(&bytes).unwrap();
+        assert_eq!(loaded.config().evidence.kind, EvidenceKind::Paper);
+        assert_eq!(loaded.config().evidence.interval_falloff, 1.0);
+        assert_eq!(loaded.grid().cells().count(), map.grid().cells().count());
+        let key = crate::storage::Resolution::new(0.25)
+            .unwrap()
+            .key_of(&nalgebra::Point3::new(1.0, 0.5, 0.0))
+            .unwrap();
+        assert_eq!(
+            crate::map::VoxelMap::memberships_at(&loaded, key),
+            crate::map::VoxelMap::memberships_at(&map, key)
+        );
+        // A version from the future is refused with its number.
+        bytes[8..10].copy_from_slice(&3u16.to_le_bytes());
+        assert!(matches!(
+            FuzzyMap::decode(&bytes),
+            Err(FormatError::UnsupportedVersion(3))
+        ));
+    }
+}

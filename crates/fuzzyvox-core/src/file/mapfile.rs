@@ -1,0 +1,377 @@
+//! The container shared by every native map file: a fixed header, a postcard body, a CRC32.
+//!
+//! Layout (little endian):
+//!
+//! | bytes | field |
+//! |---|---|
+//! | 0..8 | magic `FUZZYVOX` |
+//! | 8..10 | format version (2; 1 is still read) |
+//! | 10 | map kind (1 fuzzy, 2 log-odds, 3 alpha-cut) |
+//! | 11 | operator family code (255: none) |
+//! | 12..20 | operator parameter (f64; 0 when the family has none) |
+//! | 20..28 | resolution in metres (f64) |
+//! | 28..36 | body length in bytes (u64) |
+//! | 36..40 | CRC32 of bytes 0..36 followed by the body |
+//! | 40.. | body (postcard) |
+
+use std::io::Read;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::error::{Error, FormatError, Result};
+use crate::ops::Family;
+
+/// The first eight bytes of every native map file.
+pub const MAGIC: &[u8; 8] = b"FUZZYVOX";
+const VERSION: u16 = 2;
+/// The oldest version still read. Version 2 added the evidence model's kind and free reach to
+/// fuzzy maps' settings; a version 1 fuzzy map was built with the paper's model and loads as
+/// such. Log-odds and alpha-cut bodies are the same in both.
+const OLDEST_VERSION: u16 = 1;
+const HEADER_LEN: usize = 40;
+const NO_OPERATOR: u8 = 255;
+
+/// Which map a file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum MapKind {
+    /// The dual-set fuzzy map.
+    Fuzzy,
+    /// The log-odds map (OctoMap semantics).
+    LogOdds,
+    /// The alpha-cut log-odds map.
+    AlphaCut,
+}
+
+impl MapKind {
+    fn code(self) -> u8 {
+        match self {
+            Self::Fuzzy => 1,
+            Self::LogOdds => 2,
+            Self::AlphaCut => 3,
+        }
+    }
+
+    fn from_code(code: u8) -> Option<Self> {
+        match code {
+            1 => Some(Self::Fuzzy),
+            2 => Some(Self::LogOdds),
+            3 => Some(Self::AlphaCut),
+            _ => None,
+        }
+    }
+
+    /// Lower-case name (`fuzzy`, `logodds`, `alpha`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fuzzy => "fuzzy",
+            Self::LogOdds => "logodds",
+            Self::AlphaCut => "alpha",
+        }
+    }
+}
+
+/// The fixed header of a map file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapHeader {
+    /// Format version.
+    pub version: u16,
+    /// Map kind.
+    pub kind: MapKind,
+    /// Aggregation operator, for maps that have one.
+    pub operator: Option<Family>,
+    /// Voxel size in metres.
+    pub resolution: f64,
+    /// Body length in bytes.
+    pub body_len: u64,
+}
+
+/// Reads and checks a map file's header and checksum without decoding the body.
+pub fn read_header(path: &Path) -> Result<MapHeader> {
+    let bytes = read_file(path)?;
+    split(&bytes)
+        .map(|(header, _)| header)
+        .map_err(|reason| Error::Format {
+            path: path.to_path_buf(),
+            reason,
+        })
+}
+
+/// Reads a whole map file once and checks its header, length and checksum; returns the header
+/// and the file's bytes for the kind's decoder.
+pub fn read_checked(path: &Path) -> Result<(MapHeader, Vec<u8>)> {
+    let bytes = read_file(path)?;
+    let (header, _) = split(&bytes).map_err(|reason| Error::Format {
+        path: path.to_path_buf(),
+        reason,
+    })?;
+    Ok((header, bytes))
+}
+
+/// Serialises a whole file: header and postcard body.
+pub(crate) fn encode<T: Serialize>(
+    kind: MapKind,
+    operator: Option<Family>,
+    resolution: f64,
+    body: &T,
+) -> Vec<u8> {
+    // Encoding plain data into a Vec cannot fail.
+    let body = postcard::to_stdvec(body).unwrap_or_default();
+    let (code, parameter) = operator.map_or((NO_OPERATOR, 0.0), family_code);
+    let mut bytes = Vec::with_capacity(HEADER_LEN + body.len());
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&VERSION.to_le_bytes());
+    bytes.push(kind.code());
+    bytes.push(code);
+    bytes.extend_from_slice(&parameter.to_le_bytes());
+    bytes.extend_from_slice(&resolution.to_le_bytes());
+    bytes.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&bytes);
+    crc.update(&body);
+    bytes.extend_from_slice(&crc.finalize().to_le_bytes());
+    bytes.extend_from_slice(&body);
+    bytes
+}
+
+/// Checks magic, version, declared length and checksum; returns the header and the body.
+pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
+    if !bytes.starts_with(MAGIC) {
+        return Err(FormatError::BadMagic);
+    }
+    let Some((header, body)) = bytes.split_first_chunk::<HEADER_LEN>() else {
+        return Err(FormatError::Length {
+            declared: 0,
+            actual: 0,
+        });
+    };
+    let version = u16::from_le_bytes(field(header, 8));
+    if !(OLDEST_VERSION..=VERSION).contains(&version) {
+        return Err(FormatError::UnsupportedVersion(version));
+    }
+    let body_len = u64::from_le_bytes(field(header, 28));
+    let actual = body.len() as u64;
+    if body_len != actual {
+        return Err(FormatError::Length {
+            declared: body_len,
+            actual,
+        });
+    }
+    let stored = u32::from_le_bytes(field(header, 36));
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(header.get(..36).unwrap_or_default());
+    crc.update(body);
+    let computed = crc.finalize();
+    if stored != computed {
+        return Err(FormatError::Checksum { stored, computed });
+    }
+    let [kind_code, operator_code] = field(header, 10);
+    let kind = MapKind::from_code(kind_code)
+        .ok_or_else(|| FormatError::Invalid(format!("unknown map kind code {kind_code}")))?;
+    let parameter = f64::from_le_bytes(field(header, 12));
+    let operator = match operator_code {
+        NO_OPERATOR => None,
+        code => Some(family_from_code(code, parameter)?),
+    };
+    let resolution = f64::from_le_bytes(field(header, 20));
+    Ok((
+        MapHeader {
+            version,
+            kind,
+            operator,
+            resolution,
+            body_len,
+        },
+        body,
+    ))
+}
+
+/// `N` header bytes from offset `at` (the offsets used are constants inside the header).
+fn field<const N: usize>(header: &[u8; HEADER_LEN], at: usize) -> [u8; N] {
+    header
+        .get(at..at + N)
+        .and_then(|bytes| bytes.try_into().ok())
+        .unwrap_or([0; N])
+}
+
+/// The file methods every map has, given its `to_bytes` and `decode`: `from_bytes`, an atomic
+/// `save` and a checked `load`.
+macro_rules! native_file_methods {
+    ($map:ty) => {
+        impl $map {
+            /// Reads a map from the bytes of a native map file, checking the header, the
+            /// length, the checksum and every value.
+            pub fn from_bytes(bytes: &[u8]) -> crate::error::Result<Self> {
+                super::mapfile::from_memory(bytes, Self::decode)
+            }
+
+            /// Saves the map atomically (temporary file, sync, rename): a crash never leaves a
+            /// half-written map, and a failed save leaves the old file intact.
+            pub fn save(&self, path: impl AsRef<std::path::Path>) -> crate::error::Result<()> {
+                super::atomic::write_atomic(path.as_ref(), &self.to_bytes())
+            }
+
+            /// Loads a map saved by `save`. A damaged, truncated or foreign file is a typed
+            /// [`Error::Format`](crate::Error::Format).
+            pub fn load(path: impl AsRef<std::path::Path>) -> crate::error::Result<Self> {
+                super::mapfile::load_with(path.as_ref(), Self::decode)
+            }
+        }
+    };
+}
+pub(crate) use native_file_methods;
+
+/// Reads a map file and decodes it with `decode`, naming the file in any error.
+pub(crate) fn load_with<T>(
+    path: &Path,
+    decode: impl FnOnce(&[u8]) -> Result<T, FormatError>,
+) -> Result<T> {
+    let bytes = read_file(path)?;
+    decode(&bytes).map_err(|reason| Error::Format {
+        path: path.to_path_buf(),
+        reason,
+    })
+}
+
+/// Reads a map file header first: a file without the magic, or whose size is not the header's
+/// declared length, is refused before its body is read (so a wrong path to a huge file, or a
+/// device such as `/dev/zero`, costs 40 bytes). At most the declared length is read even from a
+/// stream, and memory grows only with the bytes that actually arrive.
+fn read_file(path: &Path) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::with_capacity(HEADER_LEN);
+    (&mut file)
+        .take(HEADER_LEN as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    let Ok(header) = <&[u8; HEADER_LEN]>::try_from(bytes.as_slice()) else {
+        // Too short: `split` names the problem.
+        return Ok(bytes);
+    };
+    if !header.starts_with(MAGIC) {
+        return Ok(bytes);
+    }
+    let declared = u64::from_le_bytes(field(header, 28));
+    let metadata = file.metadata().map_err(io)?;
+    if metadata.is_file() {
+        let actual = metadata.len().saturating_sub(HEADER_LEN as u64);
+        if actual != declared {
+            return Err(Error::Format {
+                path: path.to_path_buf(),
+                reason: FormatError::Length { declared, actual },
+            });
+        }
+    }
+    // One byte more than declared, so that a longer stream is a length error, not a long read.
+    file.take(declared.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    Ok(bytes)
+}
+
+/// Decodes map bytes held in memory.
+pub(crate) fn from_memory<T>(
+    bytes: &[u8],
+    decode: impl FnOnce(&[u8]) -> Result<T, FormatError>,
+) -> Result<T> {
+    decode(bytes).map_err(|reason| Error::Format {
+        path: "<memory>".into(),
+        reason,
+    })
+}
+
+/// Splits a file and checks that it holds a map of `kind`.
+pub(crate) fn body_of(bytes: &[u8], kind: MapKind) -> Result<(MapHeader, &[u8]), FormatError> {
+    let (header, body) = split(bytes)?;
+    if header.kind != kind {
+        return Err(FormatError::WrongKind {
+            expected: kind.name(),
+            found: header.kind.name().into(),
+        });
+    }
+    Ok((header, body))
+}
+
+fn family_code(family: Family) -> (u8, f64) {
+    let code = match family {
+        Family::Minimum => 0,
+        Family::Product => 1,
+        Family::Lukasiewicz => 2,
+        Family::Drastic => 3,
+        Family::NilpotentMinimum => 4,
+        Family::Hamacher { .. } => 5,
+        Family::Einstein => 6,
+        Family::Yager { .. } => 7,
+        Family::Frank { .. } => 8,
+        Family::Dombi { .. } => 9,
+        Family::SchweizerSklar { .. } => 10,
+        Family::AczelAlsina { .. } => 11,
+    };
+    (code, family.parameter().unwrap_or(0.0))
+}
+
+fn family_from_code(code: u8, p: f64) -> Result<Family, FormatError> {
+    let family = match code {
+        0 => Family::Minimum,
+        1 => Family::Product,
+        2 => Family::Lukasiewicz,
+        3 => Family::Drastic,
+        4 => Family::NilpotentMinimum,
+        5 => Family::Hamacher { gamma: p },
+        6 => Family::Einstein,
+        7 => Family::Yager { p },
+        8 => Family::Frank { s: p },
+        9 => Family::Dombi { lambda: p },
+        10 => Family::SchweizerSklar { p },
+        11 => Family::AczelAlsina { p },
+        _ => {
+            return Err(FormatError::Invalid(format!(
+                "unknown operator code {code}"
+            )));
+        }
+    };
+    family
+        .validate()
+        .map_err(|e| FormatError::Invalid(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_family_round_trips_through_its_code() {
+        for family in Family::catalogue() {
+            let (code, p) = family_code(family);
+            assert_eq!(family_from_code(code, p).unwrap(), family);
+        }
+    }
+
+    #[test]
+    fn damage_is_detected() {
+        let bytes = encode(
+            MapKind::Fuzzy,
+            Some(Family::Product),
+            0.1,
+            &vec![1u32, 2, 3],
+        );
+        assert!(split(&bytes).is_ok());
+        assert_eq!(
+            split(b"PK\x03\x04 zip file").unwrap_err(),
+            FormatError::BadMagic
+        );
+        assert!(matches!(
+            split(&bytes[..bytes.len() - 1]),
+            Err(FormatError::Length { .. })
+        ));
+        for i in 8..bytes.len() {
+            let mut flipped = bytes.clone();
+            flipped[i] ^= 0x10;
+            assert!(split(&flipped).is_err(), "flip at byte {i} went unnoticed");
+        }
+    }
+}

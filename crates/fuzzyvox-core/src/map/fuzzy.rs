@@ -1,0 +1,237 @@
+use rayon::prelude::*;
+
+use super::config::FuzzyConfig;
+use super::counts::VoxelCounts;
+use super::{VoxelMap, VoxelMapMut};
+use crate::error::{Error, Result};
+use crate::integrate::{
+    DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
+    cloud_evidence, depth_evidence,
+};
+use crate::measures::{MeasureConfig, Memberships, VoxelClass};
+use crate::ops::TConorm;
+use crate::storage::{BLOCK_CELLS, BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};
+
+/// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
+/// and how free (μE), each aggregated from evidence with a t-conorm `S`:
+/// `μO ← S(μO, o)`, `μE ← S(μE, e)`.
+///
+/// Because every t-conorm is commutative and associative, the map does not depend on the order
+/// of observations, and two maps of the same area [`merge`](FuzzyMap::merge) exactly.
+///
+/// ```
+/// use fuzzyvox_core::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap, VoxelMapMut};
+/// use nalgebra::Point3;
+///
+/// let mut map = FuzzyMap::new(FuzzyConfig::new(0.1)?)?;
+/// let cloud = PointCloud::new(Point3::origin(), vec![Point3::new(2.0, 0.05, 0.05)])?;
+/// map.integrate_cloud(&cloud, &IntegrationOptions::default())?;
+/// assert_eq!(map.class_at_point(&Point3::new(2.0, 0.05, 0.05))?, VoxelClass::Occupied);
+/// assert_eq!(map.class_at_point(&Point3::new(1.0, 0.05, 0.05))?, VoxelClass::Free);
+/// # Ok::<(), fuzzyvox_core::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct FuzzyMap {
+    config: FuzzyConfig,
+    grid: BlockGrid<Memberships>,
+}
+
+impl FuzzyMap {
+    /// An empty map.
+    pub fn new(config: FuzzyConfig) -> Result<Self> {
+        Ok(Self {
+            config: config.validate()?,
+            grid: BlockGrid::new(),
+        })
+    }
+
+    /// The map's configuration.
+    pub fn config(&self) -> &FuzzyConfig {
+        &self.config
+    }
+
+    /// The aggregation operator.
+    pub fn operator(&self) -> TConorm {
+        self.config.operator
+    }
+
+    /// The underlying block storage (read-only).
+    pub fn grid(&self) -> &BlockGrid<Memberships> {
+        &self.grid
+    }
+
+    /// Folds one scan's evidence into the map: one `S` per voxel and membership. Returns the
+    /// number of voxels that received evidence.
+    ///
+    /// Within one scan a voxel that holds an end point is not also cleared by the rays that
+    /// graze it: the scan's free evidence is "free and not occupied", `e · (1 - o)` (product
+    /// t-norm with the standard complement). This is the fuzzy form of OctoMap's rule that a
+    /// voxel both hit and passed in one scan counts as hit; conflict between *different* scans
+    /// still shows as ambiguity.
+    pub fn apply_evidence(&mut self, evidence: &ScanEvidence) -> usize {
+        self.fold(evidence, |e: &Evidence| {
+            (e.occupied, e.free * (1.0 - e.occupied))
+        })
+    }
+
+    /// Merges another map of the same resolution and operator into this one, cell by cell with
+    /// `S`. The result equals inserting both maps' observations into one map, in any order.
+    pub fn merge(&mut self, other: &FuzzyMap) -> Result<()> {
+        if self.config.resolution != other.config.resolution {
+            return Err(Error::Incompatible(format!(
+                "resolutions differ ({} m and {} m)",
+                self.config.resolution.size(),
+                other.config.resolution.size()
+            )));
+        }
+        if self.config.operator != other.config.operator {
+            return Err(Error::Incompatible(format!(
+                "operators differ ({} and {})",
+                self.config.operator.family(),
+                other.config.operator.family()
+            )));
+        }
+        self.fold(&other.grid, |m: &Memberships| (m.occupied, m.free));
+        Ok(())
+    }
+
+    /// Applies `S` between every cell and the matching cell of `source`, in parallel over
+    /// blocks (see [`BlockGrid::update_from`]).
+    pub(super) fn fold<C: Copy + Default + Sync>(
+        &mut self,
+        source: &BlockGrid<C>,
+        evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
+    ) -> usize {
+        let operator = self.config.operator;
+        let measures = self.config.measures;
+        let classify = |m: Memberships| measures.classify(m);
+        self.grid.update_from(source, |block, source| {
+            let mut updated = 0;
+            let mut changed = false;
+            for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
+                let (o, e) = evidence_of(s);
+                if o <= 0.0 && e <= 0.0 {
+                    continue;
+                }
+                let before = *cell;
+                if o > 0.0 {
+                    cell.occupied = operator.apply(cell.occupied, o);
+                }
+                if e > 0.0 {
+                    cell.free = operator.apply(cell.free, e);
+                }
+                changed |= cell.occupied.to_bits() != before.occupied.to_bits()
+                    || cell.free.to_bits() != before.free.to_bits();
+                // Keep the block's class counts current without reclassifying every cell.
+                block.summary.moved(classify(before), classify(*cell));
+                updated += 1;
+            }
+            (updated, changed)
+        })
+    }
+
+    /// Voxel counts per class over the allocated blocks, from the block summaries.
+    pub fn counts(&self) -> VoxelCounts {
+        VoxelCounts::of_grid(&self.grid)
+    }
+
+    /// Whether any voxel in `region` is of class `class` (voxels of unallocated blocks are
+    /// unknown), answered from block summaries where possible.
+    pub fn any_in_box(&self, region: &KeyBox, class: VoxelClass) -> bool {
+        let measures = self.config.measures;
+        self.grid
+            .any_in_box(region, class, |m| measures.classify(*m))
+    }
+
+    /// Heap memory held by the map, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.grid.memory_bytes()
+    }
+
+    /// Rebuilds a map from its configuration and storage (used by the file reader, which has
+    /// validated both).
+    pub(crate) fn from_parts(config: FuzzyConfig, mut grid: BlockGrid<Memberships>) -> Self {
+        let measures = config.measures;
+        let (_, blocks) = grid.blocks_mut();
+        blocks
+            .par_iter_mut()
+            .for_each(|b| b.refresh_summary(|m| measures.classify(*m)));
+        Self { config, grid }
+    }
+}
+
+impl VoxelMap for FuzzyMap {
+    fn counts(&self) -> VoxelCounts {
+        FuzzyMap::counts(self)
+    }
+
+    fn any_in_box(&self, region: &KeyBox, class: VoxelClass) -> bool {
+        FuzzyMap::any_in_box(self, region, class)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        FuzzyMap::memory_bytes(self)
+    }
+
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
+        Box::new(
+            self.grid
+                .cells()
+                .filter(|(_, m)| m.occupied > 0.0 || m.free > 0.0)
+                .map(|(k, m)| (k, *m)),
+        )
+    }
+
+    fn resolution(&self) -> Resolution {
+        self.config.resolution
+    }
+
+    fn write_version(&self) -> Option<u64> {
+        Some(self.grid.version())
+    }
+
+    fn changed_blocks_since(&self, version: u64) -> Option<Vec<BlockKey>> {
+        Some(self.grid.changed_since(version))
+    }
+
+    fn measure_config(&self) -> &MeasureConfig {
+        &self.config.measures
+    }
+
+    fn memberships_at(&self, key: VoxelKey) -> Memberships {
+        self.grid.cell(key).copied().unwrap_or_default()
+    }
+
+    fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
+        match self.grid.block(key) {
+            Some(block) => *out = block.cells,
+            None => out.fill(Memberships::default()),
+        }
+    }
+}
+
+impl VoxelMapMut for FuzzyMap {
+    fn integrate_cloud(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        let c = &self.config;
+        let (evidence, mut stats) =
+            cloud_evidence(cloud, &c.resolution, &c.evidence, &c.operator, options)?;
+        stats.voxels_updated = self.apply_evidence(&evidence);
+        Ok(stats)
+    }
+
+    fn integrate_depth(
+        &mut self,
+        frame: &DepthFrame,
+        options: &IntegrationOptions,
+    ) -> Result<IntegrationStats> {
+        let c = &self.config;
+        let (evidence, mut stats) =
+            depth_evidence(frame, &c.resolution, &c.evidence, &c.operator, options)?;
+        stats.voxels_updated = self.apply_evidence(&evidence);
+        Ok(stats)
+    }
+}

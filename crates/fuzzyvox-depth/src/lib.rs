@@ -1,0 +1,61 @@
+//! The depth stage (EpiDepth-style motion stereo with one camera): pair selection, extrinsic
+//! quality `Q_ABD`, rectification, census block matching, and per-pixel depth intervals
+//! `P- <= P0 <= P+` with a confidence, output as a [`DepthFrame`](fuzzyvox_core::DepthFrame) for the
+//! frustum integrator; and depth from several views at once ([`depth_from_views`],
+//! [`ViewWindow`]). See `docs/depth.md`.
+
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
+// tests (tests, benches and examples may).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::todo,
+        clippy::unimplemented,
+        clippy::unreachable
+    )
+)]
+
+use fuzzyvox_core::{error, geometry, integrate};
+
+mod census;
+mod frame;
+mod gray;
+mod interval;
+mod matching;
+mod metrics;
+mod params;
+mod pipeline;
+mod quality;
+mod rectify;
+mod scan;
+mod stream;
+mod sweep;
+mod views;
+
+pub use crate::error::UnrectifiableReason;
+pub use census::{
+    CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
+    census_transform,
+};
+pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
+pub use gray::GrayImage;
+pub use interval::{
+    IntervalMethod, IntervalParams, RELIABLE_COST, confidence, interval_image, match_reliability,
+};
+pub use matching::match_pair;
+pub use metrics::{Accuracy, evaluate};
+pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
+pub use pipeline::{
+    DepthParams, DepthResult, ForwardMotion, MatchMethod, depth_by_plane_sweep, depth_from_pair,
+    depth_from_rectified, depth_from_selected, depth_from_views,
+};
+pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
+pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry};
+pub use stream::{DepthStream, SkipReason, StreamCounts};
+pub use sweep::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
+pub use views::ViewWindow;

@@ -1,0 +1,63 @@
+//! Evaluation of maps against ground truth: the quantitative metrics the paper could not give.
+//!
+//! [`GroundTruth`] holds, for a resolution, the voxels that meet the true scene geometry and
+//! the region the cameras could observe (from the "gold standard": true depth inserted with the
+//! standard method). [`evaluate`] compares any map with it: occupied precision, recall and F1;
+//! holes (truly occupied voxels the map calls free); spurious occupied voxels in the truly
+//! unknown region (behind walls, in the sky); and the Chamfer distance from occupied voxel
+//! centres to the true surface.
+//!
+//! [`run_experiment`] feeds identical depth-stage output to every map, measures each after
+//! every phase and, optionally, plans flights in each map and checks them against the true
+//! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
+//! ray-casting them into held-out frames.
+
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
+// tests (tests, benches and examples may).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::todo,
+        clippy::unimplemented,
+        clippy::unreachable
+    )
+)]
+
+use fuzzyvox_core::{error, geometry, integrate, map, measures, ops, storage};
+use fuzzyvox_depth as depth;
+use fuzzyvox_figure as figure;
+use fuzzyvox_io as io;
+use fuzzyvox_plan as plan;
+use fuzzyvox_sim as sim;
+use fuzzyvox_view as view;
+
+mod charts;
+mod depth_stage;
+mod experiment;
+mod figures;
+mod flights;
+mod metrics;
+mod report;
+mod rgbd;
+mod truth;
+
+pub use charts::{depth_confidence_chart, maps_chart, operators_chart};
+pub use depth_stage::{ConfidenceBin, DepthStageErrors, DepthStageSummary};
+pub use experiment::{
+    DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport, run_experiment,
+    run_experiment_with_progress,
+};
+pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
+pub use flights::{
+    FailureCounts, FlightConfig, FlightFailure, FlightOutcome, FlightQuery, FlightSummary,
+    flight_queries, fly, summarize,
+};
+pub use metrics::{MapMetrics, evaluate};
+pub use report::{file_stem, markdown, report_html, write_experiment};
+pub use rgbd::{DepthAgreement, DepthCheckConfig, DepthErrors, HoldoutSplit};
+pub use truth::{GroundTruth, gold_standard, meets_geometry};

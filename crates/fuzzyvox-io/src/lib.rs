@@ -1,0 +1,45 @@
+//! Reading and writing the formats around fuzzyvox: text point clouds, RGB-D and posed-image
+//! folders, Middlebury stereo, PFM, PLY, OctoMap's `.bt`, `.ot` and scan graphs, and a loader
+//! that opens any map file. The native map files live in the core
+//! ([`fuzzyvox_core::file`]) and are re-exported here.
+//!
+//! Readers take bytes from anywhere, so this crate may not index or slice: every access to
+//! file bytes is checked (`get`, `split_at_checked`, patterns), and a bad file is an error.
+
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
+// tests (tests, benches and examples may).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::todo,
+        clippy::unimplemented,
+        clippy::unreachable
+    )
+)]
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
+use fuzzyvox_core::{error, file, geometry, integrate, map, measures, storage};
+use fuzzyvox_depth as depth;
+
+mod bounded;
+mod cloud_text;
+mod gray;
+mod load;
+pub mod middlebury;
+pub mod octomap;
+pub mod palette;
+pub mod pfm;
+pub mod ply;
+pub mod posed;
+pub mod rgbd;
+pub mod rgbd_write;
+
+pub use cloud_text::{parse_text_cloud, read_text_cloud};
+pub use fuzzyvox_core::file::{MapHeader, MapKind, read_header, write_atomic};
+pub use gray::{decode_gray_image, read_gray_image};
+pub use load::{LoadedMap, MapFormat, load_map};

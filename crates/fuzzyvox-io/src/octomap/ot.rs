@@ -1,0 +1,195 @@
+//! OctoMap's full tree files (`.ot`): an occupancy octree with a log-odds value per node.
+//!
+//! The same text header as `.bt` (see `header.rs`), with the first line `# Octomap OcTree file`
+//! and `id OcTree`. The tree follows in pre-order: each node is its log-odds (`f32`, little
+//! endian) and one byte whose bit `i` says whether child `i` exists; the children follow, each
+//! with its own subtree. A node without children is a leaf: at depth 16 a single voxel, above it
+//! a pruned cube. Child `i` of a node at depth `d` holds the keys whose bit `15 - d` is `i & 1`
+//! in x, `(i >> 1) & 1` in y and `(i >> 2) & 1` in z, as in `.bt`. Inner nodes hold the largest
+//! log-odds of their children; readers take only the leaves' values.
+//!
+//! Only OctoMap's occupancy tree (`OcTree`) is read: other tree types (`ColorOcTree`,
+//! `OcTreeStamped`, ...) store more bytes per node and are refused by name.
+
+use std::path::Path;
+
+use crate::error::{FormatError, Result};
+use crate::write_atomic;
+
+use super::bt::{TREE_DEPTH, child_corner, voxel_key};
+use super::cursor::Cursor;
+use super::header::{decode_declared, parse_header};
+use super::tree::{OcTreeMap, OctreeLeaf};
+
+/// The start of the first line of every `.ot` file.
+pub(super) const OT_HEADER: &str = "# Octomap OcTree file";
+
+/// Bytes per node: a log-odds `f32` and the child byte.
+const NODE_BYTES: usize = 5;
+
+/// A decoded `.ot` tree: its leaves in pre-order.
+pub(super) struct OtTree {
+    pub(super) resolution: f64,
+    pub(super) node_count: usize,
+    pub(super) leaves: Vec<OctreeLeaf>,
+}
+
+/// Decodes the bytes of a `.ot` file.
+///
+/// Checks, each a [`FormatError`]: the first line, an `id` of `OcTree`, a `size` and a finite
+/// positive `res`, the declared size against what the data can hold (before decoding), the tree
+/// depth (16 levels), truncation, finite leaf values, and the number of nodes read against
+/// `size`. Like OctoMap, it ignores unknown header keywords and any bytes after the tree.
+pub(super) fn decode_ot(bytes: &[u8]) -> Result<OtTree, FormatError> {
+    let header = parse_header(bytes, OT_HEADER, "an OctoMap tree (.ot)")?;
+    if header.id != "OcTree" {
+        return Err(FormatError::WrongKind {
+            expected: "OcTree",
+            found: header.id,
+        });
+    }
+    let data = bytes.get(header.data_start..).unwrap_or_default();
+    let mut tree = OtTree {
+        resolution: header.resolution,
+        node_count: 0,
+        leaves: Vec::new(),
+    };
+    if header.size == 0 {
+        return Ok(tree);
+    }
+    tree.node_count = decode_declared(header.size, data.len(), data.len() / NODE_BYTES, |n| {
+        decode_tree(data, n, &mut tree.leaves)
+    })?;
+    Ok(tree)
+}
+
+/// One inner node whose children are being visited.
+struct Frame {
+    depth: u8,
+    corner: [u32; 3],
+    children: u8,
+    next: u8,
+}
+
+/// Walks the tree with an explicit stack (at most 16 frames), appends its leaves and returns
+/// the number of nodes; stops as soon as more than `declared` nodes are seen.
+fn decode_tree(
+    data: &[u8],
+    declared: usize,
+    leaves: &mut Vec<OctreeLeaf>,
+) -> Result<usize, FormatError> {
+    let mut c = Cursor::new(data);
+    let (value, children) = node(&mut c)?;
+    if children == 0 {
+        leaves.push(leaf([0; 3], 0, value)?);
+        return Ok(1);
+    }
+    let mut nodes = 1usize;
+    let mut stack = Vec::with_capacity(usize::from(TREE_DEPTH));
+    stack.push(Frame {
+        depth: 0,
+        corner: [0; 3],
+        children,
+        next: 0,
+    });
+    while let Some(frame) = stack.last_mut() {
+        if frame.next == 8 {
+            stack.pop();
+            continue;
+        }
+        let i = u32::from(frame.next);
+        frame.next += 1;
+        if frame.children & (1 << i) == 0 {
+            continue;
+        }
+        nodes += 1;
+        if nodes > declared {
+            return Err(FormatError::Invalid(format!(
+                "the tree data holds more nodes than the {declared} the header declares"
+            )));
+        }
+        let depth = frame.depth + 1;
+        let corner = child_corner(frame.corner, frame.depth, i);
+        let at = c.position();
+        let (value, children) = node(&mut c)?;
+        if children == 0 {
+            leaves.push(leaf(corner, depth, value)?);
+        } else if depth >= TREE_DEPTH {
+            return Err(FormatError::Invalid(format!(
+                "node at byte {at} has children at depth {depth}: OctoMap trees have 16 levels"
+            )));
+        } else {
+            stack.push(Frame {
+                depth,
+                corner,
+                children,
+                next: 0,
+            });
+        }
+    }
+    Ok(nodes)
+}
+
+/// Reads one node: its log-odds and its child byte.
+fn node(c: &mut Cursor<'_>) -> Result<(f32, u8), FormatError> {
+    let value = f32::from_bits(c.u32("node value")?);
+    let children = c
+        .take(1, "child byte")?
+        .first()
+        .copied()
+        .unwrap_or_default();
+    Ok((value, children))
+}
+
+fn leaf(corner: [u32; 3], depth: u8, log_odds: f32) -> Result<OctreeLeaf, FormatError> {
+    if !log_odds.is_finite() {
+        return Err(FormatError::Invalid(format!(
+            "a leaf at depth {depth} has log-odds {log_odds}"
+        )));
+    }
+    Ok(OctreeLeaf {
+        key: voxel_key(corner),
+        depth,
+        log_odds,
+    })
+}
+
+/// Writes a tree as an OctoMap `.ot` file with [`encode_ot`], atomically.
+pub fn write_ot(path: &Path, map: &OcTreeMap) -> Result<()> {
+    write_atomic(path, &encode_ot(map))
+}
+
+/// Encodes a tree as the bytes of an OctoMap `.ot` file: OctoMap's header, then every node in
+/// pre-order, inner nodes holding the largest log-odds of their children as OctoMap's
+/// `updateInnerOccupancy` leaves them. A `.bt` tree is written with its leaves at the clamping
+/// log-odds OctoMap gives them.
+pub fn encode_ot(map: &OcTreeMap) -> Vec<u8> {
+    use crate::map::VoxelMap;
+    let (masks, data) = map.nodes();
+    let values = map.node_values();
+    let resolution = map.resolution().size();
+    let mut bytes = format!(
+        "{OT_HEADER}\n# (feel free to add / change comments, but leave the first line as it \
+         is!)\n#\nid OcTree\nsize {}\nres {resolution}\ndata\n",
+        masks.len()
+    )
+    .into_bytes();
+    bytes.reserve(masks.len() * NODE_BYTES);
+    let mut stack = if masks.is_empty() {
+        vec![]
+    } else {
+        vec![0usize]
+    };
+    while let Some(node) = stack.pop() {
+        let mask = masks.get(node).copied().unwrap_or_default();
+        let value = values.get(node).copied().unwrap_or_default();
+        bytes.extend_from_slice(&value.to_le_bytes());
+        bytes.push(mask);
+        if mask != 0 {
+            let first = data.get(node).copied().unwrap_or_default() as usize;
+            // Last child first, so that the children pop in child order.
+            stack.extend((first..first + mask.count_ones() as usize).rev());
+        }
+    }
+    bytes
+}

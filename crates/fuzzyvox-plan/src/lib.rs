@@ -1,0 +1,58 @@
+//! Planning through the maps: safety queries, a cost field with exact clearance, and A* over the
+//! implicit 26-connected voxel graph.
+//!
+//! Every map reports the same measures, so everything here runs on the fuzzy map and on both
+//! baselines through [`VoxelMap`](fuzzyvox_core::VoxelMap).
+//!
+//! 1. [`PlannerConfig`] holds every threshold and the unknown-space policy in one value.
+//! 2. [`queries`](SafetyQueries) answer "is this point safe for a vehicle of radius r", "where is
+//!    the nearest safe voxel", "which voxels of this box are safe".
+//! 3. [`CostField`] turns a map region into traversability, safety and clearance (an exact
+//!    Euclidean distance transform to the nearest blocked voxel), and step costs
+//!    `length × (1 + k (1 - S))` plus a clearance penalty.
+//! 4. [`VoxelGraph`] exposes the field through petgraph's graph traits (no graph is built), so
+//!    petgraph's own `astar` and `dijkstra` run on it; [`plan_path`] runs a dense-array A* with a
+//!    consistent heuristic over the same graph, then shortcuts the path by line of sight and
+//!    merges collinear waypoints. A start or goal it may not enter is refused with a
+//!    [`Blocker`] that says why and which setting would change it.
+//! 5. [`Planner`] owns a region's field and keeps it current as the map grows: it updates only
+//!    around the blocks the map reports changed ([`VoxelMap::changed_blocks_since`](fuzzyvox_core::VoxelMap::changed_blocks_since)),
+//!    with exactly the result of a full build, so a closed loop can replan every frame.
+
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
+// tests (tests, benches and examples may).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::todo,
+        clippy::unimplemented,
+        clippy::unreachable
+    )
+)]
+
+use fuzzyvox_core::{error, integrate, map, measures, storage};
+
+mod astar;
+mod blocker;
+mod config;
+mod cost_field;
+mod edt;
+mod field_update;
+mod graph;
+mod planner;
+mod queries;
+
+pub use astar::{Path, PlanError, plan_in_field, plan_in_field_avoiding, plan_path};
+pub use blocker::{Blocker, NearestBlocked, ObservedExtent};
+pub use config::{PlannerConfig, UnknownPolicy};
+pub use cost_field::{CostField, PlanningRegion, is_blocked};
+pub use edt::squared_distance_transform;
+pub use field_update::FieldUpdate;
+pub use graph::{VoxelEdge, VoxelGraph};
+pub use planner::Planner;
+pub use queries::SafetyQueries;

@@ -1,0 +1,129 @@
+//! A planner that follows a map as it grows: it owns the cost field of a region and updates it
+//! from the blocks each integration changed.
+
+use nalgebra::Point3;
+
+use super::astar::{Path, PlanError, plan_in_field, segment_voxels};
+use super::config::PlannerConfig;
+use super::cost_field::{CostField, PlanningRegion};
+use super::field_update::FieldUpdate;
+use crate::error::Result;
+use crate::map::VoxelMap;
+use crate::storage::VoxelKey;
+
+/// The cost field of one region of one map, kept current as the map changes.
+///
+/// [`Planner::update`] asks the map which blocks it wrote since the field last saw it
+/// ([`VoxelMap::changed_blocks_since`]) and updates only around them, so a frame's update
+/// costs in proportion to what the frame changed, not to the region; the field it leaves is
+/// bit for bit the one a full [`CostField::build`] gives. Maps that do not report their
+/// changes (read-only maps) never change, and a map whose version went backwards is rebuilt.
+///
+/// ```
+/// use fuzzyvox_plan::{Planner, PlannerConfig, PlanningRegion, UnknownPolicy};
+/// use fuzzyvox_core::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelKey, VoxelMap, VoxelMapMut};
+/// use nalgebra::Point3;
+///
+/// let mut map = FuzzyMap::new(FuzzyConfig::new(0.2)?)?;
+/// let config = PlannerConfig { unknown: UnknownPolicy::Cost(1.0), ..PlannerConfig::default() };
+/// let region = PlanningRegion::new(VoxelKey::new(-5, -15, -15), VoxelKey::new(25, 15, 15))?;
+/// let mut planner = Planner::new(&map, region, config)?;
+/// let wall: Vec<_> = (-10..=10)
+///     .flat_map(|y| (-10..=10).map(move |z| Point3::new(3.0, 0.1 * y as f64, 0.1 * z as f64)))
+///     .collect();
+/// map.integrate_cloud(&PointCloud::new(Point3::origin(), wall)?, &IntegrationOptions::default())?;
+/// let update = planner.update(&map);
+/// assert!(update.voxels_flipped > 0 && !update.rebuilt);
+/// let path = planner.plan(VoxelKey::new(0, 0, 0), VoxelKey::new(22, 0, 0))?;
+/// assert!(path.length > 4.4);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Planner {
+    field: CostField,
+    /// The map's write version the field reflects (`None` for maps that do not report one).
+    version: Option<u64>,
+}
+
+impl Planner {
+    /// Builds the field of `region` from `map`.
+    pub fn new(map: &dyn VoxelMap, region: PlanningRegion, config: PlannerConfig) -> Result<Self> {
+        Ok(Self {
+            field: CostField::build(map, region, config)?,
+            version: map.write_version(),
+        })
+    }
+
+    /// Brings the field up to date with `map` (the map it was built from): updates around the
+    /// blocks written since the last update, or rebuilds the whole field when the map cannot
+    /// say which those are.
+    pub fn update(&mut self, map: &dyn VoxelMap) -> FieldUpdate {
+        let now = map.write_version();
+        let changed = match (self.version, now) {
+            (Some(before), Some(after)) if after >= before => map.changed_blocks_since(before),
+            (None, None) => Some(Vec::new()),
+            _ => None,
+        };
+        self.version = now;
+        match changed {
+            Some(blocks) => self.field.update(map, &blocks),
+            None => {
+                let region = *self.field.region();
+                let config = *self.field.config();
+                // The configuration was validated when the field was first built.
+                if let Ok(field) = CostField::build(map, region, config) {
+                    self.field = field;
+                }
+                FieldUpdate {
+                    rebuilt: true,
+                    ..FieldUpdate::default()
+                }
+            }
+        }
+    }
+
+    /// The current field.
+    pub fn field(&self) -> &CostField {
+        &self.field
+    }
+
+    /// A* from `start` to `goal` through the current field ([`plan_in_field`]).
+    pub fn plan(&self, start: VoxelKey, goal: VoxelKey) -> std::result::Result<Path, PlanError> {
+        plan_in_field(&self.field, start, goal)
+    }
+
+    /// Whether every straight leg of `waypoints` crosses only traversable voxels of the
+    /// current field (the test the planner's own shortcuts pass), so that a path planned
+    /// earlier can be kept while the map grows.
+    pub fn is_clear(&self, waypoints: &[Point3<f64>]) -> bool {
+        self.is_clear_avoiding(waypoints, &|_| false)
+    }
+
+    /// [`is_clear`](Planner::is_clear) that also refuses every voxel (dense index) for which
+    /// `avoid` is true, the first waypoint's voxel excepted (the vehicle is there already).
+    pub fn is_clear_avoiding(
+        &self,
+        waypoints: &[Point3<f64>],
+        avoid: &dyn Fn(usize) -> bool,
+    ) -> bool {
+        let resolution = self.field.resolution();
+        let keys: Option<Vec<VoxelKey>> = waypoints
+            .iter()
+            .map(|p| resolution.key_of(p).ok())
+            .collect();
+        let Some(keys) = keys else {
+            return false;
+        };
+        let region = self.field.region();
+        let Some(first) = keys.first().and_then(|k| region.index_of(*k)) else {
+            return false;
+        };
+        let enter = |i: usize| self.field.is_traversable(i) && (i == first || !avoid(i));
+        match keys.as_slice() {
+            [_] => enter(first),
+            _ => keys
+                .windows(2)
+                .all(|leg| segment_voxels(&self.field, leg[0], leg[1], enter)),
+        }
+    }
+}
