@@ -617,3 +617,117 @@ fn printed_plan_examples_work() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A map of `cloud` (text `x y z` lines) from `origin`, saved as `dir/name.fvx`.
+fn insert_map(
+    dir: &std::path::Path,
+    name: &str,
+    points: &str,
+    extra: &[&str],
+) -> std::path::PathBuf {
+    let cloud = dir.join(format!("{name}.xyz"));
+    std::fs::write(&cloud, points).unwrap();
+    let map = dir.join(format!("{name}.fvx"));
+    let mut args = vec![
+        "insert",
+        "--cloud",
+        cloud.to_str().unwrap(),
+        "--origin",
+        "0,0,0.5",
+        "--out",
+        map.to_str().unwrap(),
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    json(&fuzzyvox(&args));
+    map
+}
+
+#[test]
+fn merge_combines_fuzzy_maps_and_refuses_the_rest() {
+    use fuzzyvox::AnyMap;
+    let dir = std::env::temp_dir().join(format!("fuzzyvox-cli-merge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Two halves of a wall seen from the same place, and the wall seen through a gap.
+    let mut left = String::new();
+    let mut right = String::new();
+    for i in 0..=60 {
+        for j in 0..=40 {
+            let (y, z) = (-3.0 + 0.05 * f64::from(i), -1.0 + 0.05 * f64::from(j));
+            left.push_str(&format!("3.0 {y} {z}\n"));
+            right.push_str(&format!("3.0 {} {z}\n", -y));
+        }
+    }
+    let a = insert_map(&dir, "left", &left, &["--res", "0.1"]);
+    let b = insert_map(&dir, "right", &right, &["--res", "0.1"]);
+    let out = dir.join("merged.fvx");
+    let report = json(&fuzzyvox(&[
+        "merge",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["maps"], 2);
+    // The command's map is the library's merge of the two files, byte for byte.
+    let (AnyMap::Fuzzy(mut expected), AnyMap::Fuzzy(other)) =
+        (AnyMap::load(&a).unwrap(), AnyMap::load(&b).unwrap())
+    else {
+        panic!("fuzzy maps expected");
+    };
+    let (left_occupied, right_occupied) = (expected.counts().occupied, other.counts().occupied);
+    expected.merge(&other).unwrap();
+    assert_eq!(std::fs::read(&out).unwrap(), expected.to_bytes());
+    let merged = AnyMap::load(&out).unwrap();
+    let occupied = merged.as_map().counts().occupied;
+    assert_eq!(report["occupied"], occupied);
+    assert!(
+        occupied > left_occupied.max(right_occupied),
+        "{occupied} occupied"
+    );
+    assert_eq!(
+        merged
+            .as_map()
+            .class_at_point(&nalgebra::Point3::new(3.0, -2.0, 0.0))
+            .unwrap(),
+        fuzzyvox::VoxelClass::Occupied
+    );
+
+    // Refused, and nothing written: another resolution, a log-odds map, an OctoMap tree.
+    let coarse = insert_map(&dir, "coarse", &left, &["--res", "0.2"]);
+    let logodds = insert_map(
+        &dir,
+        "logodds",
+        &left,
+        &["--res", "0.1", "--model", "logodds"],
+    );
+    let refused = dir.join("refused.fvx");
+    for (other, message) in [
+        (&coarse, "resolutions differ"),
+        (&logodds, "only fuzzy maps merge"),
+    ] {
+        let run = fuzzyvox(&[
+            "merge",
+            a.to_str().unwrap(),
+            other.to_str().unwrap(),
+            "--out",
+            refused.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success() && stderr.contains(message),
+            "{stderr}"
+        );
+        assert!(!refused.exists());
+    }
+    let missing = fuzzyvox(&[
+        "merge",
+        "/nonexistent.fvx",
+        "--out",
+        refused.to_str().unwrap(),
+    ]);
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("/nonexistent.fvx"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -10,6 +10,7 @@ mod info;
 mod input;
 mod insert;
 mod maps;
+mod merge;
 mod mono;
 mod plan;
 pub mod progress;
@@ -33,6 +34,7 @@ use clap::{Parser, Subcommand};
         fuzzyvox demo\n  \
         fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
         fuzzyvox info scan.fvx\n  \
+        fuzzyvox merge part-1.fvx part-2.fvx --out whole.fvx\n  \
         fuzzyvox export scan.fvx --png top.png --ply scan.ply --bt scan.bt\n  \
         fuzzyvox view scan.fvx --out scan.html\n  \
         fuzzyvox plan --map scan.fvx --from 3,0,0.5 --to 7,-11,0.5\n  \
@@ -53,6 +55,7 @@ struct Cli {
 enum Command {
     Insert(insert::InsertArgs),
     Info(info::InfoArgs),
+    Merge(merge::MergeArgs),
     Export(export::ExportArgs),
     Eval(eval::EvalArgs),
     Demo(demo::DemoArgs),
@@ -72,6 +75,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Insert(args) => insert::run(args),
         Command::Info(args) => info::run(args),
+        Command::Merge(args) => merge::run(args),
         Command::Export(args) => export::run(args),
         Command::Eval(args) => eval::run(args),
         Command::Demo(args) => demo::run(args),
