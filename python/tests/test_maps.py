@@ -297,3 +297,21 @@ def test_read_cloud(tmp_path):
     path.write_text("1 2 three\n")
     with pytest.raises(fuzzyvox.MapFileError, match=":1"):
         fuzzyvox.read_cloud(path)
+
+
+def test_threads_integrate_into_their_own_maps():
+    # Integration releases the GIL: threads integrating into separate maps give the maps a
+    # serial run gives.
+    from concurrent.futures import ThreadPoolExecutor
+
+    clouds = [room_cloud(seed, 3000) for seed in range(4)]
+
+    def build(pts):
+        m = fuzzyvox.FuzzyMap(0.2)
+        m.integrate_cloud(pts, origin=(0, 0, 0.5))
+        return m.to_bytes()
+
+    with ThreadPoolExecutor(4) as pool:
+        threaded = list(pool.map(build, clouds))
+    assert threaded == [build(c) for c in clouds]
+    assert len(set(threaded)) == 4
