@@ -147,6 +147,16 @@ class Plan:
     def __len__(self) -> int: ...
 
 @final
+class RgbdFolder:
+    """An RGB-D folder (7-Scenes layout) read as Kinect interval depth frames."""
+
+    def __init__(self, path: _Path) -> None: ...
+    @property
+    def numbers(self) -> list[int]: ...
+    def __len__(self) -> int: ...
+    def frame(self, index: int) -> dict[str, Any]: ...
+
+@final
 class Scenario:
     """A simulated world and a camera flight through it."""
 

@@ -13,6 +13,7 @@ mod arrays;
 mod errors;
 mod maps;
 mod plan;
+mod rgbd;
 mod scenario;
 
 use fuzzyvox_core::{AnyMap, Family, TConorm};
@@ -156,6 +157,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<maps::AlphaCutMap>()?;
     m.add_class::<plan::Plan>()?;
     m.add_class::<Operator>()?;
+    m.add_class::<rgbd::RgbdFolder>()?;
     m.add_class::<scenario::Scenario>()?;
     m.add_class::<scenario::GroundTruth>()?;
     m.add_class::<scenario::Experiment>()?;

@@ -24,6 +24,11 @@ def scan_dat() -> Path:
     return data_file("octomap-samples/scan.dat")
 
 
+@pytest.fixture
+def rgbd_dir() -> Path:
+    return data_file("rgbd-7scenes-redkitchen/camera-intrinsics.txt").parent
+
+
 def wall_points(n: int = 50, x: float = 3.0) -> np.ndarray:
     """A line of points on the plane x = `x`, seen from the origin."""
     ys = -1.0 + 0.04 * np.arange(n)

@@ -21,3 +21,45 @@ def test_scan_dat(scan_dat):
     share = np.mean(m.classes(points[::50]) == fuzzyvox.OCCUPIED)
     assert share > 0.5
     assert pickle.loads(pickle.dumps(m)).to_bytes() == m.to_bytes()
+
+
+def test_rgbd_frames(rgbd_dir):
+    folder = fuzzyvox.RgbdFolder(rgbd_dir)
+    assert len(folder) == 50
+    assert folder.numbers == sorted(folder.numbers)
+    frame = folder.frame(0)
+    assert frame["value"].shape == (480, 640) and frame["value"].dtype == np.float32
+    valid = frame["value"] > 0
+    assert np.all(frame["near"][valid] < frame["value"][valid])
+    assert np.all(frame["value"][valid] < frame["far"][valid])
+    m = fuzzyvox.FuzzyMap(0.05)
+    stats = m.integrate_depth(**frame)
+    assert stats["integrated"] == int(valid.sum())
+    # The surface seen at the centre pixel is occupied, the way to it free.
+    z = float(frame["value"][240, 320])
+    assert z > 0
+    pose = frame["pose"]
+    along = [pose[:3, :3] @ np.array([0.0, 0.0, d]) + pose[:3, 3] for d in (z, z / 2)]
+    assert m.classes(np.array(along), names=True) == ["occupied", "free"]
+    assert folder.frame(-1)["pose"].shape == (4, 4)
+    try:
+        folder.frame(50)
+    except ValueError as e:
+        assert "out of range" in str(e)
+    else:
+        raise AssertionError("frame 50 of 50 did not raise")
+
+
+def test_rgbd_frames_merge_as_serial(rgbd_dir):
+    folder = fuzzyvox.RgbdFolder(rgbd_dir)
+    frames = [folder.frame(i) for i in range(0, 40, 10)]
+    serial = fuzzyvox.FuzzyMap(0.05)
+    halves = [fuzzyvox.FuzzyMap(0.05), fuzzyvox.FuzzyMap(0.05)]
+    for i, f in enumerate(frames):
+        serial.integrate_depth(**f)
+        halves[i // 2].integrate_depth(**f)
+    halves[0].merge(halves[1])
+    centres, mu = serial.voxels()
+    assert len(halves[0].voxels()[0]) == len(centres)
+    assert np.abs(halves[0].memberships(centres) - mu).max() < 1e-5
+    assert np.array_equal(halves[0].classes(centres), serial.classes(centres))
