@@ -3,9 +3,12 @@ in a tree, checked against serial integration of the same parts.
 
     python dask_mapping.py                        # $FUZZYVOX_DATA/octomap-samples/scan.dat
     python dask_mapping.py --cloud scan.dat --parts 8 --res 0.1
+    python dask_mapping.py --rgbd $FUZZYVOX_DATA/rgbd-7scenes-redkitchen --res 0.05
     python dask_mapping.py --scheduler tcp://host:8786   # a real cluster instead of a local one
 
-The cloud is split into `--parts` parts; each part is integrated as one scan (from the same
+With `--rgbd DIR` the parts are the frames of an RGB-D folder (Kinect depth as intervals), each
+task integrating a run of frames that it reads itself (the workers need the folder's path).
+Otherwise the cloud is split into `--parts` parts; each part is integrated as one scan (from the same
 sensor origin). Each task builds a partial map from a run of consecutive parts; the partial
 maps travel between processes by pickle (the native file bytes) and are merged pairwise, a
 tree of merges of depth log2(tasks). The serial reference integrates the same parts, in order,
@@ -53,6 +56,15 @@ def tree_reduce(client, futures: list):
     return futures[0]
 
 
+def partial_rgbd_map(folder: str, indices: list[int], res: float, op: str) -> fuzzyvox.FuzzyMap:
+    """One worker's map of RGB-D frames: the frames `indices` of `folder`, in order."""
+    frames = fuzzyvox.RgbdFolder(folder)
+    m = fuzzyvox.FuzzyMap(res, op=op)
+    for i in indices:
+        m.integrate_depth(**frames.frame(i))
+    return m
+
+
 def compare(a: fuzzyvox.FuzzyMap, b: fuzzyvox.FuzzyMap) -> dict:
     """How two maps differ: byte equality of their native files, the largest membership
     difference over every voxel either observed, and whether every such voxel has one class."""
@@ -92,11 +104,34 @@ def run(client, points: np.ndarray, parts: int = 8, tasks: int = 4, origin=(0.0,
     return result
 
 
+def run_rgbd(client, folder: str, frames: list[int], tasks: int = 4, res: float = 0.05, op: str = "product", timeout: float | None = None) -> dict:
+    """`run` for the frames `frames` of an RGB-D folder: `tasks` runs of frames integrated on
+    the cluster and merged in a tree, and all of them serially."""
+    groups = [list(map(int, g)) for g in np.array_split(np.array(frames), tasks) if len(g)]
+    started = time.perf_counter()
+    futures = [client.submit(partial_rgbd_map, folder, g, res, op) for g in groups]
+    distributed_map = tree_reduce(client, futures).result(timeout=timeout)
+    distributed_seconds = time.perf_counter() - started
+    started = time.perf_counter()
+    serial_map = partial_rgbd_map(folder, frames, res, op)
+    serial_seconds = time.perf_counter() - started
+    result = compare(distributed_map, serial_map)
+    result.update(
+        distributed=distributed_map,
+        serial=serial_map,
+        distributed_seconds=distributed_seconds,
+        serial_seconds=serial_seconds,
+        tasks=len(groups),
+    )
+    return result
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     default = Path(os.environ.get("FUZZYVOX_DATA", "../shared/data")) / "octomap-samples" / "scan.dat"
     parser.add_argument("--cloud", type=Path, default=default, help="text cloud (x y z per line)")
-    parser.add_argument("--parts", type=int, default=8)
+    parser.add_argument("--rgbd", type=Path, help="an RGB-D folder (7-Scenes layout) instead of a cloud")
+    parser.add_argument("--parts", type=int, default=8, help="parts of the cloud")
     parser.add_argument("--tasks", type=int, default=4)
     parser.add_argument("--res", type=float, default=0.1)
     parser.add_argument("--op", default="product")
@@ -106,7 +141,12 @@ def main() -> int:
 
     from distributed import Client, LocalCluster
 
-    points, _ = fuzzyvox.read_cloud(args.cloud)
+    if args.rgbd:
+        frames = list(range(len(fuzzyvox.RgbdFolder(args.rgbd))))
+        what = f"{len(frames)} RGB-D frames of {args.rgbd.name}"
+    else:
+        points, _ = fuzzyvox.read_cloud(args.cloud)
+        what = f"{len(points)} points in {args.parts} parts"
     if args.scheduler:
         client = Client(args.scheduler)
         cluster = None
@@ -117,12 +157,15 @@ def main() -> int:
         )
         client = Client(cluster)
     try:
-        r = run(client, points, args.parts, args.tasks, res=args.res, op=args.op)
+        if args.rgbd:
+            r = run_rgbd(client, str(args.rgbd.resolve()), frames, args.tasks, res=args.res, op=args.op)
+        else:
+            r = run(client, points, args.parts, args.tasks, res=args.res, op=args.op)
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
-    print(f"{len(points)} points in {args.parts} parts, {r['tasks']} partial maps merged in a tree")
+    print(f"{what}, {r['tasks']} partial maps merged in a tree")
     print(f"distributed: {r['distributed_seconds']:.2f} s; serial: {r['serial_seconds']:.2f} s")
     print(f"observed voxels: {r['voxels'][0]} distributed, {r['voxels'][1]} serial")
     print(f"every voxel of the same class: {r['classes_equal']}")
