@@ -1,5 +1,8 @@
 """The t-conorm catalogue and operator parsing."""
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -45,3 +48,12 @@ def test_every_operator_builds_a_map_that_sees_the_wall():
         mu = m.memberships(q)
         assert mu[0, 0] > mu[0, 1], name  # the wall: more occupied than free
         assert mu[1, 1] > mu[1, 0], name  # the way to it: more free than occupied
+
+
+def test_the_package_readme_example_runs(capsys):
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", readme, flags=re.S)
+    assert blocks
+    for block in blocks:
+        exec(compile(block, "python/README.md", "exec"), {})
+    assert "occupied" in capsys.readouterr().out
