@@ -118,6 +118,8 @@ Map = Union[FuzzyMap, LogOddsMap, AlphaCutMap]
 class Operator:
     """A parsed t-conorm (``parse_operator``)."""
 
+    def __init__(self, text: str) -> None: ...
+    def __reduce__(self) -> Any: ...
     @property
     def name(self) -> str: ...
     @property
@@ -132,6 +134,16 @@ class Operator:
 class Plan:
     """A planned path and its figures."""
 
+    def __init__(
+        self,
+        waypoints: npt.ArrayLike,
+        length: float,
+        cost: float,
+        min_safety: float,
+        min_clearance: float,
+        expanded: int,
+    ) -> None: ...
+    def __reduce__(self) -> Any: ...
     @property
     def waypoints(self) -> npt.NDArray[np.float64]: ...
     @property

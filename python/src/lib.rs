@@ -75,6 +75,28 @@ struct Operator {
 
 #[pymethods]
 impl Operator {
+    /// ``Operator("dombi:2")`` is ``parse_operator("dombi:2")``.
+    #[new]
+    fn new(text: &str) -> PyResult<Self> {
+        parse_operator(text)
+    }
+
+    /// Pickles as its canonical name.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, pyo3::types::PyType>, (String,)) {
+        (slf.get_type(), (slf.get().conorm.family().to_string(),))
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.conorm.family() == other.conorm.family()
+    }
+
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.conorm.family().to_string().hash(&mut h);
+        h.finish()
+    }
+
     /// The family's name (``dombi``).
     #[getter]
     fn name(&self) -> &'static str {

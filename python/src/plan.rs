@@ -33,6 +33,50 @@ pub struct Plan {
 
 #[pymethods]
 impl Plan {
+    /// A plan from its parts (as pickling rebuilds one); ``plan()`` makes plans.
+    #[new]
+    #[pyo3(signature = (waypoints, length, cost, min_safety, min_clearance, expanded))]
+    fn new(
+        waypoints: &Bound<'_, PyAny>,
+        length: f64,
+        cost: f64,
+        min_safety: f32,
+        min_clearance: f32,
+        expanded: usize,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            waypoints: arrays::points(waypoints, "waypoints")?,
+            length,
+            cost,
+            min_safety,
+            min_clearance,
+            expanded,
+        })
+    }
+
+    /// Pickles through its parts.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, pyo3::types::PyType>,
+        (Bound<'py, PyArray2<f64>>, f64, f64, f32, f32, usize),
+    )> {
+        let py = slf.py();
+        let p = slf.get();
+        Ok((
+            slf.get_type(),
+            (
+                arrays::points_out(py, &p.waypoints),
+                p.length,
+                p.cost,
+                p.min_safety,
+                p.min_clearance,
+                p.expanded,
+            ),
+        ))
+    }
+
     /// The waypoints (voxel centres, start first): a (K, 3) float64 array.
     #[getter]
     fn waypoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {

@@ -57,3 +57,13 @@ def test_the_package_readme_example_runs(capsys):
     for block in blocks:
         exec(compile(block, "python/README.md", "exec"), {})
     assert "occupied" in capsys.readouterr().out
+
+
+def test_operators_pickle_and_compare():
+    import pickle
+
+    op = fuzzyvox.Operator("Dombi:2")
+    assert op == fuzzyvox.parse_operator("dombi:2") != fuzzyvox.Operator("dombi:3")
+    again = pickle.loads(pickle.dumps(op))
+    assert again == op and str(again) == "dombi:2"
+    assert len({op, again, fuzzyvox.Operator("max")}) == 2

@@ -1,5 +1,7 @@
 """Planning through the maps from Python."""
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -41,6 +43,11 @@ def test_plan_through_the_corridor(cls):
     assert p.expanded > 0
     # Every waypoint is in known-safe space.
     assert np.all(m.classes(w) == fuzzyvox.FREE)
+    # Plans pickle (for example back from Dask workers).
+    again = pickle.loads(pickle.dumps(p))
+    assert np.array_equal(again.waypoints, w)
+    assert (again.length, again.cost, again.min_safety, again.min_clearance, again.expanded) == (
+        p.length, p.cost, p.min_safety, p.min_clearance, p.expanded)
 
 
 def test_plan_failures_say_why():
