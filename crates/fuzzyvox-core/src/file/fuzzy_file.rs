@@ -4,13 +4,21 @@ use super::mapfile::{self, MapKind};
 use super::stored_blocks::{self, StoredBlock};
 use crate::error::{FormatError, Result};
 use crate::integrate::EvidenceModel;
-use crate::map::{FuzzyConfig, FuzzyMap};
+use crate::map::{Accumulator, FuzzyConfig, FuzzyMap, Levels};
 use crate::measures::{MeasureConfig, Memberships};
 use crate::ops::TConorm;
 use crate::storage::Resolution;
 
+/// A format version 3 body: memberships as levels of the operator's generator.
 #[derive(Serialize, Deserialize)]
 struct Body {
+    config: FuzzyConfig,
+    blocks: Vec<StoredBlock<Levels>>,
+}
+
+/// A format version 2 body: memberships as `f32`.
+#[derive(Serialize, Deserialize)]
+struct BodyV2 {
     config: FuzzyConfig,
     blocks: Vec<StoredBlock<Memberships>>,
 }
@@ -39,10 +47,10 @@ struct EvidenceV1 {
     interval_falloff: f32,
 }
 
-impl From<BodyV1> for Body {
+impl From<BodyV1> for BodyV2 {
     fn from(old: BodyV1) -> Self {
         let e = old.config.evidence;
-        Body {
+        BodyV2 {
             config: FuzzyConfig {
                 resolution: old.config.resolution,
                 operator: old.config.operator,
@@ -81,12 +89,43 @@ impl FuzzyMap {
     fn decode(bytes: &[u8]) -> Result<Self, FormatError> {
         let (header, body) = mapfile::body_of(bytes, MapKind::Fuzzy)?;
         let invalid = FormatError::Invalid;
-        let body: Body = if header.version == 1 {
-            postcard::from_bytes::<BodyV1>(body)
-                .map_err(|e| invalid(e.to_string()))?
-                .into()
-        } else {
-            postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?
+        let old: Option<BodyV2> = match header.version {
+            1 => Some(
+                postcard::from_bytes::<BodyV1>(body)
+                    .map_err(|e| invalid(e.to_string()))?
+                    .into(),
+            ),
+            2 => Some(postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?),
+            _ => None,
+        };
+        let body: Body = match old {
+            Some(old) => {
+                // Memberships before version 3: every one becomes the nearest level.
+                let unit = |v: f32| (0.0..=1.0).contains(&v);
+                if let Some(bad) = old.blocks.iter().find(|b| {
+                    !b.cells
+                        .iter()
+                        .all(|m: &Memberships| unit(m.occupied) && unit(m.free))
+                }) {
+                    return Err(invalid(format!(
+                        "a membership outside [0, 1] in block {:?}",
+                        bad.key
+                    )));
+                }
+                let acc = Accumulator::new(old.config.operator);
+                Body {
+                    config: old.config,
+                    blocks: old
+                        .blocks
+                        .into_iter()
+                        .map(|b| StoredBlock {
+                            key: b.key,
+                            cells: b.cells.iter().map(|m| acc.levels(*m)).collect(),
+                        })
+                        .collect(),
+                }
+            }
+            None => postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?,
         };
         let config = body.config.validate().map_err(|e| invalid(e.to_string()))?;
         if header.resolution != config.resolution.size()
@@ -94,10 +133,9 @@ impl FuzzyMap {
         {
             return Err(invalid("header and body disagree".into()));
         }
-        let unit = |v: f32| (0.0..=1.0).contains(&v);
-        let grid = stored_blocks::restore(body.blocks, |m: &Memberships| {
-            unit(m.occupied) && unit(m.free)
-        })?;
+        // Every level reads as a membership in [0, 1]; levels past the operator's cap read
+        // as its largest membership.
+        let grid = stored_blocks::restore(body.blocks, |_: &Levels| true)?;
         Ok(FuzzyMap::from_parts(config, grid))
     }
 }
@@ -106,6 +144,15 @@ impl FuzzyMap {
 mod tests {
     use super::*;
     use crate::integrate::EvidenceKind;
+
+    /// The map's memberships as a version 1 or 2 file stored them.
+    fn memberships_grid(map: &FuzzyMap) -> crate::storage::BlockGrid<Memberships> {
+        let mut grid = crate::storage::BlockGrid::new();
+        for (key, levels) in map.grid().cells() {
+            *grid.cell_or_insert(key) = map.accumulator().memberships(*levels);
+        }
+        grid
+    }
 
     /// A version 1 file (written before the evidence model had a kind) loads with the paper's
     /// model, its memberships intact.
@@ -131,7 +178,7 @@ mod tests {
                 },
                 measures: config.measures,
             },
-            blocks: stored_blocks::store(map.grid()),
+            blocks: stored_blocks::store(&memberships_grid(&map)),
         };
         let mut bytes = mapfile::encode(MapKind::Fuzzy, Some(config.operator.family()), 0.25, &old);
         // Rewrite the header as version 1 and fix the checksum.
@@ -154,10 +201,10 @@ mod tests {
             crate::map::VoxelMap::memberships_at(&map, key)
         );
         // A version from the future is refused with its number.
-        bytes[8..10].copy_from_slice(&3u16.to_le_bytes());
+        bytes[8..10].copy_from_slice(&4u16.to_le_bytes());
         assert!(matches!(
             FuzzyMap::decode(&bytes),
-            Err(FormatError::UnsupportedVersion(3))
+            Err(FormatError::UnsupportedVersion(4))
         ));
     }
 }

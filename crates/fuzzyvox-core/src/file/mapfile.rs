@@ -5,7 +5,7 @@
 //! | bytes | field |
 //! |---|---|
 //! | 0..8 | magic `FUZZYVOX` |
-//! | 8..10 | format version (2; 1 is still read) |
+//! | 8..10 | format version (3; 1 and 2 are still read) |
 //! | 10 | map kind (1 fuzzy, 2 log-odds, 3 alpha-cut) |
 //! | 11 | operator family code (255: none) |
 //! | 12..20 | operator parameter (f64; 0 when the family has none) |
@@ -24,10 +24,12 @@ use crate::ops::Family;
 
 /// The first eight bytes of every native map file.
 pub const MAGIC: &[u8; 8] = b"FUZZYVOX";
-const VERSION: u16 = 2;
+const VERSION: u16 = 3;
 /// The oldest version still read. Version 2 added the evidence model's kind and free reach to
 /// fuzzy maps' settings; a version 1 fuzzy map was built with the paper's model and loads as
-/// such. Log-odds and alpha-cut bodies are the same in both.
+/// such. Version 3 stores a fuzzy map's memberships as levels of its operator's generator
+/// (exact accumulation, `map::Accumulator`); a version 1 or 2 fuzzy map's `f32` memberships are
+/// converted to the nearest levels as it loads. Log-odds and alpha-cut bodies are the same in both.
 const OLDEST_VERSION: u16 = 1;
 const HEADER_LEN: usize = 40;
 const NO_OPERATOR: u8 = 255;

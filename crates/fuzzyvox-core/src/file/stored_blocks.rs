@@ -10,8 +10,8 @@ use crate::storage::{BLOCK_CELLS, Block, BlockGrid, BlockKey};
 /// One stored block.
 #[derive(Serialize, Deserialize)]
 pub(crate) struct StoredBlock<C> {
-    key: BlockKey,
-    cells: Vec<C>,
+    pub(crate) key: BlockKey,
+    pub(crate) cells: Vec<C>,
 }
 
 /// The grid's blocks in key order.

@@ -2,6 +2,7 @@ use rayon::prelude::*;
 
 use super::config::FuzzyConfig;
 use super::counts::VoxelCounts;
+use super::levels::{Accumulator, Levels};
 use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
 use crate::integrate::{
@@ -17,7 +18,10 @@ use crate::storage::{BLOCK_CELLS, BlockGrid, BlockKey, KeyBox, Resolution, Voxel
 /// `μO ← S(μO, o)`, `μE ← S(μE, e)`.
 ///
 /// Because every t-conorm is commutative and associative, the map does not depend on the order
-/// of observations, and two maps of the same area [`merge`](FuzzyMap::merge) exactly.
+/// of observations, and two maps of the same area [`merge`](FuzzyMap::merge) exactly: the map
+/// stores each membership as a fixed-point level of the t-conorm's generator
+/// ([`Accumulator`]), so the same observations give the same map bit for bit, whatever their
+/// order, however they are split into merged partial maps and on any number of threads.
 ///
 /// ```
 /// use fuzzyvox_core::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelClass, VoxelMap, VoxelMapMut};
@@ -33,14 +37,17 @@ use crate::storage::{BLOCK_CELLS, BlockGrid, BlockKey, KeyBox, Resolution, Voxel
 #[derive(Clone, Debug)]
 pub struct FuzzyMap {
     config: FuzzyConfig,
-    grid: BlockGrid<Memberships>,
+    accumulator: Accumulator,
+    grid: BlockGrid<Levels>,
 }
 
 impl FuzzyMap {
     /// An empty map.
     pub fn new(config: FuzzyConfig) -> Result<Self> {
+        let config = config.validate()?;
         Ok(Self {
-            config: config.validate()?,
+            accumulator: Accumulator::new(config.operator),
+            config,
             grid: BlockGrid::new(),
         })
     }
@@ -55,8 +62,14 @@ impl FuzzyMap {
         self.config.operator
     }
 
-    /// The underlying block storage (read-only).
-    pub fn grid(&self) -> &BlockGrid<Memberships> {
+    /// How the map stores and accumulates memberships (levels of the operator's generator).
+    pub fn accumulator(&self) -> &Accumulator {
+        &self.accumulator
+    }
+
+    /// The underlying block storage (read-only): each voxel's [`Levels`], which
+    /// [`Accumulator::memberships`] reads as memberships.
+    pub fn grid(&self) -> &BlockGrid<Levels> {
         &self.grid
     }
 
@@ -91,40 +104,66 @@ impl FuzzyMap {
                 other.config.operator.family()
             )));
         }
-        self.fold(&other.grid, |m: &Memberships| (m.occupied, m.free));
+        let acc = self.accumulator;
+        self.update(&other.grid, |cell, s: &Levels| {
+            if *s == Levels::default() {
+                return false;
+            }
+            cell.occupied = acc.combine(cell.occupied, s.occupied);
+            cell.free = acc.combine(cell.free, s.free);
+            true
+        });
         Ok(())
     }
 
-    /// Applies `S` between every cell and the matching cell of `source`, in parallel over
-    /// blocks (see [`BlockGrid::update_from`]).
+    /// Applies `S` between every cell and the evidence `(o, e)` of the matching cell of
+    /// `source`, in parallel over blocks (see [`BlockGrid::update_from`]).
     pub(super) fn fold<C: Copy + Default + Sync>(
         &mut self,
         source: &BlockGrid<C>,
         evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
     ) -> usize {
-        let operator = self.config.operator;
+        let acc = self.accumulator;
+        self.update(source, |cell, s| {
+            let (o, e) = evidence_of(s);
+            if o <= 0.0 && e <= 0.0 {
+                return false;
+            }
+            if o > 0.0 {
+                cell.occupied = acc.accumulate(cell.occupied, o);
+            }
+            if e > 0.0 {
+                cell.free = acc.accumulate(cell.free, e);
+            }
+            true
+        })
+    }
+
+    /// Updates every cell with the matching cell of `source` (`update` says whether the cell
+    /// received anything), in parallel over blocks, keeping the blocks' class counts current
+    /// and marking only blocks whose levels changed. Returns the number of cells updated.
+    fn update<C: Copy + Default + Sync>(
+        &mut self,
+        source: &BlockGrid<C>,
+        update: impl Fn(&mut Levels, &C) -> bool + Sync,
+    ) -> usize {
+        let acc = self.accumulator;
         let measures = self.config.measures;
-        let classify = |m: Memberships| measures.classify(m);
+        let classify = |l: Levels| measures.classify(acc.memberships(l));
         self.grid.update_from(source, |block, source| {
             let mut updated = 0;
             let mut changed = false;
             for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
-                let (o, e) = evidence_of(s);
-                if o <= 0.0 && e <= 0.0 {
+                let before = *cell;
+                if !update(cell, s) {
                     continue;
                 }
-                let before = *cell;
-                if o > 0.0 {
-                    cell.occupied = operator.apply(cell.occupied, o);
-                }
-                if e > 0.0 {
-                    cell.free = operator.apply(cell.free, e);
-                }
-                changed |= cell.occupied.to_bits() != before.occupied.to_bits()
-                    || cell.free.to_bits() != before.free.to_bits();
-                // Keep the block's class counts current without reclassifying every cell.
-                block.summary.moved(classify(before), classify(*cell));
                 updated += 1;
+                if *cell != before {
+                    changed = true;
+                    // Keep the block's class counts current without reclassifying every cell.
+                    block.summary.moved(classify(before), classify(*cell));
+                }
             }
             (updated, changed)
         })
@@ -138,9 +177,9 @@ impl FuzzyMap {
     /// Whether any voxel in `region` is of class `class` (voxels of unallocated blocks are
     /// unknown), answered from block summaries where possible.
     pub fn any_in_box(&self, region: &KeyBox, class: VoxelClass) -> bool {
-        let measures = self.config.measures;
+        let (acc, measures) = (self.accumulator, self.config.measures);
         self.grid
-            .any_in_box(region, class, |m| measures.classify(*m))
+            .any_in_box(region, class, |l| measures.classify(acc.memberships(*l)))
     }
 
     /// Heap memory held by the map, in bytes.
@@ -150,13 +189,17 @@ impl FuzzyMap {
 
     /// Rebuilds a map from its configuration and storage (used by the file reader, which has
     /// validated both).
-    pub(crate) fn from_parts(config: FuzzyConfig, mut grid: BlockGrid<Memberships>) -> Self {
-        let measures = config.measures;
+    pub(crate) fn from_parts(config: FuzzyConfig, mut grid: BlockGrid<Levels>) -> Self {
+        let (acc, measures) = (Accumulator::new(config.operator), config.measures);
         let (_, blocks) = grid.blocks_mut();
         blocks
             .par_iter_mut()
-            .for_each(|b| b.refresh_summary(|m| measures.classify(*m)));
-        Self { config, grid }
+            .for_each(|b| b.refresh_summary(|l| measures.classify(acc.memberships(*l))));
+        Self {
+            config,
+            accumulator: acc,
+            grid,
+        }
     }
 }
 
@@ -174,11 +217,12 @@ impl VoxelMap for FuzzyMap {
     }
 
     fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, Memberships)> + '_> {
+        let acc = self.accumulator;
         Box::new(
             self.grid
                 .cells()
-                .filter(|(_, m)| m.occupied > 0.0 || m.free > 0.0)
-                .map(|(k, m)| (k, *m)),
+                .filter(|(_, l)| **l != Levels::default())
+                .map(move |(k, l)| (k, acc.memberships(*l))),
         )
     }
 
@@ -199,12 +243,18 @@ impl VoxelMap for FuzzyMap {
     }
 
     fn memberships_at(&self, key: VoxelKey) -> Memberships {
-        self.grid.cell(key).copied().unwrap_or_default()
+        self.grid
+            .cell(key)
+            .map_or_else(Memberships::default, |l| self.accumulator.memberships(*l))
     }
 
     fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
         match self.grid.block(key) {
-            Some(block) => *out = block.cells,
+            Some(block) => {
+                for (m, l) in out.iter_mut().zip(&block.cells) {
+                    *m = self.accumulator.memberships(*l);
+                }
+            }
             None => out.fill(Memberships::default()),
         }
     }
