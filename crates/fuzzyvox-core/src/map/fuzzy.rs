@@ -105,7 +105,7 @@ impl FuzzyMap {
             )));
         }
         let acc = self.accumulator;
-        self.update(&other.grid, |cell, s: &Levels| {
+        self.update(&other.grid, |cell, s: &Levels, _| {
             if *s == Levels::default() {
                 return false;
             }
@@ -124,16 +124,16 @@ impl FuzzyMap {
         evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
     ) -> usize {
         let acc = self.accumulator;
-        self.update(source, |cell, s| {
+        self.update(source, |cell, s, memo| {
             let (o, e) = evidence_of(s);
             if o <= 0.0 && e <= 0.0 {
                 return false;
             }
             if o > 0.0 {
-                cell.occupied = acc.accumulate(cell.occupied, o);
+                cell.occupied = acc.accumulate_level(cell.occupied, memo.level(&acc, o));
             }
             if e > 0.0 {
-                cell.free = acc.accumulate(cell.free, e);
+                cell.free = acc.accumulate_level(cell.free, memo.level(&acc, e));
             }
             true
         })
@@ -145,24 +145,28 @@ impl FuzzyMap {
     fn update<C: Copy + Default + Sync>(
         &mut self,
         source: &BlockGrid<C>,
-        update: impl Fn(&mut Levels, &C) -> bool + Sync,
+        update: impl Fn(&mut Levels, &C, &mut LevelMemo) -> bool + Sync,
     ) -> usize {
         let acc = self.accumulator;
         let measures = self.config.measures;
-        let classify = |l: Levels| measures.classify(acc.memberships(l));
         self.grid.update_from(source, |block, source| {
             let mut updated = 0;
             let mut changed = false;
+            // Cells of a block often hold the same levels (space a scan cleared once): classify
+            // each distinct pair once in a row.
+            let mut classes = ClassMemo::new(&acc, &measures);
+            let mut levels = LevelMemo::default();
             for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
                 let before = *cell;
-                if !update(cell, s) {
+                if !update(cell, s, &mut levels) {
                     continue;
                 }
                 updated += 1;
                 if *cell != before {
                     changed = true;
                     // Keep the block's class counts current without reclassifying every cell.
-                    block.summary.moved(classify(before), classify(*cell));
+                    let from = classes.of(before);
+                    block.summary.moved(from, classes.of(*cell));
                 }
             }
             (updated, changed)
@@ -200,6 +204,58 @@ impl FuzzyMap {
             accumulator: acc,
             grid,
         }
+    }
+}
+
+/// The level of the last evidence value seen (a scan gives many voxels of a block the same
+/// evidence), computed again only for another value.
+#[derive(Default)]
+struct LevelMemo {
+    last: Option<(u32, u32)>,
+}
+
+impl LevelMemo {
+    #[inline]
+    fn level(&mut self, acc: &Accumulator, evidence: f32) -> u32 {
+        let bits = evidence.to_bits();
+        match self.last {
+            Some((seen, level)) if seen == bits => level,
+            _ => {
+                let level = acc.evidence_level(evidence);
+                self.last = Some((bits, level));
+                level
+            }
+        }
+    }
+}
+
+/// The classes of the last two level pairs seen: `measures.classify` of their memberships,
+/// decoded only for a pair not seen just before.
+struct ClassMemo<'a> {
+    acc: &'a Accumulator,
+    measures: &'a MeasureConfig,
+    recent: [Option<(Levels, VoxelClass)>; 2],
+}
+
+impl<'a> ClassMemo<'a> {
+    fn new(acc: &'a Accumulator, measures: &'a MeasureConfig) -> Self {
+        Self {
+            acc,
+            measures,
+            recent: [None; 2],
+        }
+    }
+
+    #[inline]
+    fn of(&mut self, levels: Levels) -> VoxelClass {
+        for (seen, class) in self.recent.iter().flatten() {
+            if *seen == levels {
+                return *class;
+            }
+        }
+        let class = self.measures.classify(self.acc.memberships(levels));
+        self.recent = [Some((levels, class)), self.recent[0]];
+        class
     }
 }
 

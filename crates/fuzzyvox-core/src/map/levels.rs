@@ -195,11 +195,28 @@ impl Accumulator {
     /// `S(stored, evidence)`: the level after `evidence` (a membership) joins a stored level.
     #[inline]
     pub fn accumulate(&self, level: u32, evidence: f32) -> u32 {
+        self.accumulate_level(level, self.evidence_level(evidence))
+    }
+
+    /// What `evidence` (a membership) adds: its level, or for the t-conorms without a
+    /// generator its `f32` bits.
+    #[inline]
+    pub fn evidence_level(&self, evidence: f32) -> u32 {
         match self.scale {
-            Scale::Generator { .. } => self.combine(level, self.level(evidence)),
+            Scale::Generator { .. } => self.level(evidence),
+            Scale::Bits => evidence.to_bits(),
+        }
+    }
+
+    /// [`Accumulator::accumulate`] with the evidence already as
+    /// [`Accumulator::evidence_level`].
+    #[inline]
+    pub fn accumulate_level(&self, level: u32, evidence: u32) -> u32 {
+        match self.scale {
+            Scale::Generator { .. } => self.combine(level, evidence),
             Scale::Bits => self
                 .operator
-                .apply(f32::from_bits(level), evidence)
+                .apply(f32::from_bits(level), f32::from_bits(evidence))
                 .to_bits(),
         }
     }
