@@ -12,9 +12,9 @@ Otherwise the cloud is split into `--parts` parts; each part is integrated as on
 sensor origin). Each task builds a partial map from a run of consecutive parts; the partial
 maps travel between processes by pickle (the native file bytes) and are merged pairwise, a
 tree of merges of depth log2(tasks). The serial reference integrates the same parts, in order,
-into one map. The fuzzy map's t-conorms are commutative and associative, so both maps hold the
-same memberships; whether they hold the same *bits* depends on the merge rounding exactly as
-serial integration does, which the check reports (`to_bytes` equality) along with the largest
+into one map. The fuzzy map's t-conorms are commutative and associative, and the map
+accumulates them exactly (fixed-point levels of the generator), so both maps are the same bit
+for bit: the check compares their native file bytes (`to_bytes`) and also reports the largest
 membership difference and whether every voxel has the same class.
 """
 
