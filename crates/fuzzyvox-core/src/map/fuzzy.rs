@@ -306,11 +306,7 @@ impl VoxelMap for FuzzyMap {
 
     fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
         match self.grid.block(key) {
-            Some(block) => {
-                for (m, l) in out.iter_mut().zip(&block.cells) {
-                    *m = self.accumulator.memberships(*l);
-                }
-            }
+            Some(block) => self.accumulator.memberships_into(&block.cells, out),
             None => out.fill(Memberships::default()),
         }
     }

@@ -170,6 +170,25 @@ impl Accumulator {
         }
     }
 
+    /// The memberships of many voxels' levels, in order. Neighbouring voxels often hold the
+    /// same level (space cleared by the same scans), so each set's last level is read once.
+    pub fn memberships_into(&self, levels: &[Levels], out: &mut [Memberships]) {
+        // Level 0 reads as 0 for every operator.
+        let (mut occupied, mut free) = ((0, 0.0), (0, 0.0));
+        for (m, l) in out.iter_mut().zip(levels) {
+            if l.occupied != occupied.0 {
+                occupied = (l.occupied, self.membership(l.occupied));
+            }
+            if l.free != free.0 {
+                free = (l.free, self.membership(l.free));
+            }
+            *m = Memberships {
+                occupied: occupied.1,
+                free: free.1,
+            };
+        }
+    }
+
     /// Both levels of a voxel's memberships.
     pub fn levels(&self, memberships: Memberships) -> Levels {
         Levels {
@@ -364,6 +383,27 @@ mod tests {
                 "{name}: {}",
                 max(name)
             );
+        }
+    }
+
+    #[test]
+    fn many_levels_read_as_one_at_a_time() {
+        for acc in accumulators() {
+            let levels: Vec<Levels> = memberships(300)
+                .chunks(2)
+                .flat_map(|p| {
+                    let l = acc.levels(Memberships {
+                        occupied: p[0],
+                        free: p[1],
+                    });
+                    [l, l, Levels::default(), l]
+                })
+                .collect();
+            let mut out = vec![Memberships::default(); levels.len()];
+            acc.memberships_into(&levels, &mut out);
+            for (l, m) in levels.iter().zip(&out) {
+                assert_eq!(*m, acc.memberships(*l), "{:?}", acc.operator());
+            }
         }
     }
 
