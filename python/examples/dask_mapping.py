@@ -86,34 +86,28 @@ def run(client, points: np.ndarray, parts: int = 8, tasks: int = 4, origin=(0.0,
     (seconds) bounds the wait for the cluster's result."""
     chunks = np.array_split(points, parts)
     groups = [list(g) for g in np.array_split(np.arange(parts), tasks) if len(g)]
-    started = time.perf_counter()
-    futures = [client.submit(partial_map, [chunks[i] for i in g], origin, res, op) for g in groups]
-    distributed_map = tree_reduce(client, futures).result(timeout=timeout)
-    distributed_seconds = time.perf_counter() - started
-    started = time.perf_counter()
-    serial_map = partial_map(chunks, origin, res, op)
-    serial_seconds = time.perf_counter() - started
-    result = compare(distributed_map, serial_map)
-    result.update(
-        distributed=distributed_map,
-        serial=serial_map,
-        distributed_seconds=distributed_seconds,
-        serial_seconds=serial_seconds,
-        tasks=len(groups),
-    )
-    return result
+    jobs = [(partial_map, [chunks[i] for i in g], origin, res, op) for g in groups]
+    return against_serial(client, jobs, lambda: partial_map(chunks, origin, res, op), timeout)
 
 
 def run_rgbd(client, folder: str, frames: list[int], tasks: int = 4, res: float = 0.05, op: str = "product", timeout: float | None = None) -> dict:
     """`run` for the frames `frames` of an RGB-D folder: `tasks` runs of frames integrated on
     the cluster and merged in a tree, and all of them serially."""
     groups = [list(map(int, g)) for g in np.array_split(np.array(frames), tasks) if len(g)]
+    jobs = [(partial_rgbd_map, folder, g, res, op) for g in groups]
+    return against_serial(client, jobs, lambda: partial_rgbd_map(folder, frames, res, op), timeout)
+
+
+def against_serial(client, jobs: list, serial, timeout: float | None) -> dict:
+    """Builds one partial map per job (`(function, *arguments)`) on the cluster, merges them in
+    a tree, builds `serial()` here, and returns both maps, their timings and `compare`'s
+    result."""
     started = time.perf_counter()
-    futures = [client.submit(partial_rgbd_map, folder, g, res, op) for g in groups]
+    futures = [client.submit(*job) for job in jobs]
     distributed_map = tree_reduce(client, futures).result(timeout=timeout)
     distributed_seconds = time.perf_counter() - started
     started = time.perf_counter()
-    serial_map = partial_rgbd_map(folder, frames, res, op)
+    serial_map = serial()
     serial_seconds = time.perf_counter() - started
     result = compare(distributed_map, serial_map)
     result.update(
@@ -121,7 +115,7 @@ def run_rgbd(client, folder: str, frames: list[int], tasks: int = 4, res: float 
         serial=serial_map,
         distributed_seconds=distributed_seconds,
         serial_seconds=serial_seconds,
-        tasks=len(groups),
+        tasks=len(jobs),
     )
     return result
 
