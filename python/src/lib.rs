@@ -26,31 +26,8 @@ use crate::errors::{OrRaise, invalid};
 #[pyfunction]
 fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Py<PyAny>> {
     let data = data.to_vec();
-    let map = py.detach(|| decode_any(&data)).or_raise()?;
+    let map = py.detach(|| AnyMap::from_bytes(&data)).or_raise()?;
     maps::wrap(py, map)
-}
-
-fn decode_any(bytes: &[u8]) -> fuzzyvox_core::Result<AnyMap> {
-    use fuzzyvox_core::{AlphaCutMap, FuzzyMap, LogOddsMap};
-    // Each decoder checks the header's kind; the first that accepts the bytes wins, and an
-    // error names what the bytes are.
-    match FuzzyMap::from_bytes(bytes) {
-        Ok(m) => return Ok(AnyMap::Fuzzy(m)),
-        Err(fuzzyvox_core::Error::Format {
-            reason: fuzzyvox_core::FormatError::WrongKind { .. },
-            ..
-        }) => {}
-        Err(e) => return Err(e),
-    }
-    match LogOddsMap::from_bytes(bytes) {
-        Ok(m) => return Ok(AnyMap::LogOdds(m)),
-        Err(fuzzyvox_core::Error::Format {
-            reason: fuzzyvox_core::FormatError::WrongKind { .. },
-            ..
-        }) => {}
-        Err(e) => return Err(e),
-    }
-    AlphaCutMap::from_bytes(bytes).map(AnyMap::Alpha)
 }
 
 /// Loads a native ``.fvx`` map file of any kind.

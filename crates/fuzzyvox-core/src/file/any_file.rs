@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::mapfile::{MapHeader, MapKind, read_checked};
+use super::mapfile::{MapHeader, MapKind, from_memory, read_checked, split};
 use crate::error::{Error, Result};
 use crate::map::{AlphaCutMap, AnyMap, FuzzyMap, LogOddsMap};
 
@@ -12,14 +12,25 @@ impl AnyMap {
         Self::load_with_header(path.as_ref()).map(|(_, map)| map)
     }
 
+    /// A map of whichever kind the bytes of a native map file (`to_bytes`) hold. Errors name
+    /// the bytes `<memory>`.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let header = from_memory(bytes, |b| split(b).map(|(header, _)| header))?;
+        Self::decode(&header, bytes)
+    }
+
+    fn decode(header: &MapHeader, bytes: &[u8]) -> Result<Self> {
+        match header.kind {
+            MapKind::Fuzzy => FuzzyMap::from_bytes(bytes).map(Self::Fuzzy),
+            MapKind::LogOdds => LogOddsMap::from_bytes(bytes).map(Self::LogOdds),
+            MapKind::AlphaCut => AlphaCutMap::from_bytes(bytes).map(Self::Alpha),
+        }
+    }
+
     /// Loads a native map file of any kind, reading it once, with its header.
     pub fn load_with_header(path: &Path) -> Result<(MapHeader, Self)> {
         let (header, bytes) = read_checked(path)?;
-        let map = match header.kind {
-            MapKind::Fuzzy => FuzzyMap::from_bytes(&bytes).map(Self::Fuzzy),
-            MapKind::LogOdds => LogOddsMap::from_bytes(&bytes).map(Self::LogOdds),
-            MapKind::AlphaCut => AlphaCutMap::from_bytes(&bytes).map(Self::Alpha),
-        };
+        let map = Self::decode(&header, &bytes);
         // The decoders name the bytes `<memory>`; name the file instead.
         let map = map.map_err(|error| match error {
             Error::Format { reason, .. } => Error::Format {
@@ -56,5 +67,30 @@ impl AnyMap {
             Self::LogOdds(_) => MapKind::LogOdds,
             Self::Alpha(_) => MapKind::AlphaCut,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::{AlphaConfig, FuzzyConfig, LogOddsConfig};
+
+    #[test]
+    fn bytes_of_any_kind_decode_as_their_kind() {
+        let maps = [
+            AnyMap::Fuzzy(FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap()),
+            AnyMap::LogOdds(LogOddsMap::new(LogOddsConfig::new(0.2).unwrap()).unwrap()),
+            AnyMap::Alpha(AlphaCutMap::new(AlphaConfig::new(0.2).unwrap()).unwrap()),
+        ];
+        for map in maps {
+            let bytes = map.to_bytes();
+            let back = AnyMap::from_bytes(&bytes).unwrap();
+            assert_eq!(back.kind(), map.kind());
+            assert_eq!(back.to_bytes(), bytes);
+        }
+        assert!(matches!(
+            AnyMap::from_bytes(b"not a map"),
+            Err(Error::Format { path, reason: crate::error::FormatError::BadMagic }) if path.as_os_str() == "<memory>"
+        ));
     }
 }
