@@ -133,9 +133,11 @@ impl FuzzyMap {
         {
             return Err(invalid("header and body disagree".into()));
         }
-        // Every level reads as a membership in [0, 1]; levels past the operator's cap read
-        // as its largest membership.
-        let grid = stored_blocks::restore(body.blocks, |_: &Levels| true)?;
+        // Every level must be one the operator's accumulator can produce.
+        let acc = Accumulator::new(config.operator);
+        let grid = stored_blocks::restore(body.blocks, |l: &Levels| {
+            acc.is_valid(l.occupied) && acc.is_valid(l.free)
+        })?;
         Ok(FuzzyMap::from_parts(config, grid))
     }
 }

@@ -135,6 +135,15 @@ impl Accumulator {
         }
     }
 
+    /// Whether `level` is one this accumulator can produce: at most the cap in generator space,
+    /// or the bits of a membership in `[0, 1]` (files with other levels are damaged).
+    pub fn is_valid(&self, level: u32) -> bool {
+        match self.scale {
+            Scale::Generator { cap, .. } => level <= cap,
+            Scale::Bits => (0.0..=1.0).contains(&f32::from_bits(level)),
+        }
+    }
+
     /// The membership a level stands for: `g⁽⁻¹⁾(level · δ)`, or the `f32` of its bits.
     #[inline]
     pub fn membership(&self, level: u32) -> f32 {
@@ -410,6 +419,17 @@ mod tests {
     #[test]
     fn bad_levels_read_as_memberships_in_range() {
         for acc in accumulators() {
+            for mu in memberships(50) {
+                assert!(acc.is_valid(acc.level(mu)), "{:?}", acc.operator());
+            }
+            // Negative zero, NaN and 2 as bits; past the cap in generator space.
+            let bad = match acc.step() {
+                Some(_) => acc.level(1.0) < u32::MAX && !acc.is_valid(acc.level(1.0) + 1),
+                None => [(-0.5f32).to_bits(), f32::NAN.to_bits(), 2.0f32.to_bits()]
+                    .iter()
+                    .all(|l| !acc.is_valid(*l)),
+            };
+            assert!(bad || acc.level(1.0) == u32::MAX, "{:?}", acc.operator());
             for level in [1, 12_345, u32::MAX / 2, u32::MAX - 1, u32::MAX] {
                 let mu = acc.membership(level);
                 assert!(
