@@ -3,11 +3,12 @@ use nalgebra::Point3;
 use super::blocker::{Blocker, NearestBlocked};
 use super::config::{PlannerConfig, UnknownPolicy};
 use super::edt::squared_distance_transform;
-use super::field_update::{Change, block_parts, read_parts};
+use super::field_update::block_parts;
+use super::least_rate::LeastRate;
 use crate::error::{Error, Result};
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
-use crate::storage::{BlockKey, Resolution, VoxelKey};
+use crate::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
 
 /// Largest planning region, in voxels (a guard against absurd requests: 64 Mi voxels use about
 /// 1 GiB of working memory).
@@ -134,19 +135,61 @@ pub struct CostField {
     config: PlannerConfig,
     /// Per voxel, dense index order (x fastest). One record per voxel rather than one array
     /// per entry: an update reads and writes a voxel's entries together, one cache line.
-    voxels: Vec<Voxel>,
-    min_rate: f32,
+    pub(super) voxels: Vec<Voxel>,
+    /// Per voxel, the stamp it was read with ([`VoxelMap::block_stamps`]), when the map keeps
+    /// stamps: an update decodes only the voxels whose stamp changed.
+    pub(super) stamps: Option<Vec<u64>>,
+    /// The least rate of any voxel, kept as voxels change.
+    pub(super) least: LeastRate,
 }
 
 /// What the field knows of one voxel.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Voxel {
-    safety: f32,
-    clearance: f32,
+pub(super) struct Voxel {
+    pub(super) safety: f32,
+    pub(super) clearance: f32,
     /// Cost per metre (infinite when not traversable).
-    rate: f32,
-    class: VoxelClass,
-    traversable: bool,
+    pub(super) rate: f32,
+    pub(super) class: VoxelClass,
+    pub(super) traversable: bool,
+}
+
+/// The rules that turn a voxel's class, safety and clearance into whether it is blocked or
+/// traversable and what it costs, with the configuration's derived figures computed once.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rules {
+    config: PlannerConfig,
+    /// [`CostField::required_clearance`].
+    required: f32,
+    /// The preferred clearance (never 0).
+    preferred: f32,
+}
+
+impl Rules {
+    /// Whether a voxel of this class and safety is blocked ([`is_blocked`]).
+    #[inline]
+    pub(super) fn blocked(&self, class: VoxelClass, safety: f32) -> bool {
+        is_blocked(class, safety, &self.config)
+    }
+
+    /// Whether a voxel of this class, safety and clearance is traversable, and its rate.
+    #[inline]
+    pub(super) fn entry(&self, class: VoxelClass, safety: f32, clearance: f32) -> (bool, f32) {
+        let config = &self.config;
+        let traversable = !self.blocked(class, safety) && clearance >= self.required;
+        let rate = if traversable {
+            let unknown = match (class, config.unknown) {
+                (VoxelClass::Unknown, UnknownPolicy::Cost(c)) => c,
+                _ => 0.0,
+            };
+            1.0 + config.safety_weight * (1.0 - safety)
+                + config.clearance_weight * (1.0 - clearance / self.preferred).max(0.0)
+                + unknown
+        } else {
+            f32::INFINITY
+        };
+        (traversable, rate)
+    }
 }
 
 impl Voxel {
@@ -169,32 +212,28 @@ impl CostField {
         let config = config.validate()?;
         let resolution = map.resolution();
         let n = region.len();
+        let stamped = map.block_stamps(region.min().block(), &mut [0; BLOCK_CELLS]);
         let mut field = Self {
             region,
             resolution,
             config,
             voxels: vec![Voxel::UNKNOWN; n],
-            min_rate: 1.0,
+            stamps: stamped.then(|| vec![0; n]),
+            least: LeastRate::scan::<f32>(&[], |r| *r),
         };
         // Every voxel of the region lies in one of the blocks of its box.
         let (lo, hi) = (region.min().block(), region.key_at(n - 1).block());
         let blocks = (lo.z..=hi.z).flat_map(|z| {
             (lo.y..=hi.y).flat_map(move |y| (lo.x..=hi.x).map(move |x| BlockKey::new(x, y, z)))
         });
-        for voxels in read_parts(map, &region, &block_parts(&region, blocks), |i, s, c| {
-            Some((i, s, c))
-        }) {
-            for (i, safety, class) in voxels {
-                field.voxels[i].safety = safety;
-                field.voxels[i].class = class;
-            }
-        }
+        field.fill(map, &block_parts(&region, blocks));
         let whole = region.dims().map(|d| 0..d as i64);
         field.recompute_clearance(&whole);
-        for i in 0..n {
-            field.derive(i);
+        let rules = field.rules();
+        for v in &mut field.voxels {
+            (v.traversable, v.rate) = rules.entry(v.class, v.safety, v.clearance);
         }
-        field.refresh_min_rate();
+        field.rescan_least_rate();
         Ok(field)
     }
 
@@ -264,67 +303,33 @@ impl CostField {
     }
 
     /// Sets whether the voxel at `index` is traversable and its rate, from its class, safety
-    /// and clearance.
+    /// and clearance, keeping the least rate.
     #[inline]
     pub(super) fn derive(&mut self, i: usize) {
         let v = self.voxels[i];
-        (self.voxels[i].traversable, self.voxels[i].rate) =
-            self.entry(v.class, v.safety, v.clearance);
+        let (traversable, rate) = self.entry(v.class, v.safety, v.clearance);
+        self.least.replace(v.rate, rate);
+        (self.voxels[i].traversable, self.voxels[i].rate) = (traversable, rate);
+    }
+
+    /// The rules that give a voxel's traversability and rate.
+    pub(super) fn rules(&self) -> Rules {
+        Rules {
+            config: self.config,
+            required: self.required_clearance() as f32,
+            preferred: self.config.preferred_clearance.max(1e-9) as f32,
+        }
     }
 
     /// Whether a voxel of this class, safety and clearance is traversable, and its rate.
     #[inline]
     pub(super) fn entry(&self, class: VoxelClass, safety: f32, clearance: f32) -> (bool, f32) {
-        let required = self.required_clearance() as f32;
-        let traversable = !is_blocked(class, safety, &self.config) && clearance >= required;
-        let rate = if traversable {
-            let unknown = match (class, self.config.unknown) {
-                (VoxelClass::Unknown, UnknownPolicy::Cost(c)) => c,
-                _ => 0.0,
-            };
-            let preferred = self.config.preferred_clearance.max(1e-9) as f32;
-            1.0 + self.config.safety_weight * (1.0 - safety)
-                + self.config.clearance_weight * (1.0 - clearance / preferred).max(0.0)
-                + unknown
-        } else {
-            f32::INFINITY
-        };
-        (traversable, rate)
+        self.rules().entry(class, safety, clearance)
     }
 
-    /// Recomputes [`CostField::min_rate`]. (Eight running minima, so that the loop vectorises;
-    /// rates are never NaN, so the order of comparisons does not matter.)
-    pub(super) fn refresh_min_rate(&mut self) {
-        let mut lanes = [f32::INFINITY; 8];
-        let chunks = self.voxels.chunks_exact(8);
-        let rest = chunks.remainder();
-        for chunk in chunks {
-            for (lane, v) in lanes.iter_mut().zip(chunk) {
-                *lane = if v.rate < *lane { v.rate } else { *lane };
-            }
-        }
-        let least = lanes
-            .iter()
-            .copied()
-            .chain(rest.iter().map(|v| v.rate))
-            .fold(f32::INFINITY, |a, b| if b < a { b } else { a });
-        self.min_rate = least.max(1.0);
-    }
-
-    /// Writes a changed voxel's class, safety, traversability and rate.
-    pub(super) fn set_entries(&mut self, change: &Change) {
-        let i = change.index;
-        let v = &mut self.voxels[i];
-        v.safety = change.safety;
-        v.class = change.class;
-        v.traversable = change.traversable;
-        v.rate = change.rate;
-    }
-
-    /// Whether the stored class and safety of the voxel at `index` are these.
-    pub(super) fn has_measures(&self, i: usize, safety: f32, class: VoxelClass) -> bool {
-        let v = &self.voxels[i];
-        v.class == class && v.safety.to_bits() == safety.to_bits()
+    /// Finds the least rate again by scanning every voxel.
+    pub(super) fn rescan_least_rate(&mut self) {
+        self.least = LeastRate::scan(&self.voxels, |v| v.rate);
     }
 
     /// The region.
@@ -461,7 +466,7 @@ impl CostField {
     /// The lowest cost per metre of any traversable voxel (at least 1): every step of length `l`
     /// costs at least `l × min_rate`, which keeps A*'s distance heuristic consistent and tight.
     pub fn min_rate(&self) -> f32 {
-        self.min_rate
+        self.least.value().max(1.0)
     }
 
     /// Cost of a straight step of `length` metres between two voxels.

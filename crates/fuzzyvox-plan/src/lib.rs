@@ -44,6 +44,7 @@ mod cost_field;
 mod edt;
 mod field_update;
 mod graph;
+mod least_rate;
 mod planner;
 mod queries;
 

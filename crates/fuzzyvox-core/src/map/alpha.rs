@@ -119,6 +119,14 @@ impl VoxelMap for AlphaCutMap {
         self.inner.block_memberships(key, out);
     }
 
+    fn block_stamps(&self, key: BlockKey, out: &mut [u64; BLOCK_CELLS]) -> bool {
+        self.inner.block_stamps(key, out)
+    }
+
+    fn memberships_of_stamps(&self, stamps: &[u64], out: &mut [Memberships]) {
+        self.inner.memberships_of_stamps(stamps, out);
+    }
+
     fn counts(&self) -> VoxelCounts {
         self.inner.counts()
     }

@@ -310,6 +310,24 @@ impl VoxelMap for FuzzyMap {
             None => out.fill(Memberships::default()),
         }
     }
+
+    fn block_stamps(&self, key: BlockKey, out: &mut [u64; BLOCK_CELLS]) -> bool {
+        match self.grid.block(key) {
+            Some(block) => {
+                for (stamp, levels) in out.iter_mut().zip(&block.cells) {
+                    *stamp = levels.packed();
+                }
+            }
+            None => out.fill(Levels::default().packed()),
+        }
+        true
+    }
+
+    fn memberships_of_stamps(&self, stamps: &[u64], out: &mut [Memberships]) {
+        for (m, stamp) in out.iter_mut().zip(stamps) {
+            *m = self.accumulator.memberships(Levels::unpacked(*stamp));
+        }
+    }
 }
 
 impl VoxelMapMut for FuzzyMap {

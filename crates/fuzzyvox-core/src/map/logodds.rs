@@ -327,6 +327,24 @@ impl VoxelMap for LogOddsMap {
         }
     }
 
+    fn block_stamps(&self, key: BlockKey, out: &mut [u64; BLOCK_CELLS]) -> bool {
+        match self.grid.block(key) {
+            Some(block) => {
+                for (stamp, cell) in out.iter_mut().zip(&block.cells) {
+                    *stamp = u64::from(cell.0.to_bits());
+                }
+            }
+            None => out.fill(u64::from(LogOdds::default().0.to_bits())),
+        }
+        true
+    }
+
+    fn memberships_of_stamps(&self, stamps: &[u64], out: &mut [Memberships]) {
+        for (m, stamp) in out.iter_mut().zip(stamps) {
+            *m = LogOdds(f32::from_bits(*stamp as u32)).memberships();
+        }
+    }
+
     fn counts(&self) -> VoxelCounts {
         LogOddsMap::counts(self)
     }

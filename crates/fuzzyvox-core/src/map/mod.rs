@@ -55,6 +55,24 @@ pub trait VoxelMap: Send + Sync {
         }
     }
 
+    /// The stored state of the voxels of one block ([`BlockKey::voxel`] order) as opaque
+    /// **stamps** into `out`, for consumers that follow a map's changes cell by cell: a voxel's
+    /// memberships are [`VoxelMap::memberships_of_stamps`] of its stamp, so a voxel whose stamp
+    /// is the one read before has not changed, and a consumer that keeps the stamps it read
+    /// decodes only the voxels that did. Voxels nothing is known about have the stamp of an
+    /// empty cell. Returns `false`, leaving `out` as it was, when the map keeps no such state
+    /// (the default).
+    fn block_stamps(&self, _key: BlockKey, _out: &mut [u64; BLOCK_CELLS]) -> bool {
+        false
+    }
+
+    /// The memberships of the voxels whose stamps are `stamps` (see
+    /// [`VoxelMap::block_stamps`]), in order, into `out` (as many as `stamps`; maps without
+    /// stamps answer zero memberships).
+    fn memberships_of_stamps(&self, _stamps: &[u64], out: &mut [Memberships]) {
+        out.fill(Memberships::default());
+    }
+
     /// Voxel counts per class over the allocated blocks (from block summaries).
     fn counts(&self) -> VoxelCounts;
 
