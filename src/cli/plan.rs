@@ -156,6 +156,7 @@ fn failure_name(error: &PlanError) -> &'static str {
         PlanError::OutOfRegion(_) => "out_of_region",
         PlanError::StartUnsafe(_) => "start_unsafe",
         PlanError::GoalUnsafe(_) => "goal_unsafe",
+        PlanError::GoalAvoided => "goal_avoided",
         PlanError::Disconnected { .. } => "disconnected",
         PlanError::Map(_) => "invalid_request",
     }

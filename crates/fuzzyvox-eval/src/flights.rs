@@ -93,7 +93,7 @@ impl FlightFailure {
     pub fn of(error: &PlanError) -> Self {
         match error {
             PlanError::StartUnsafe { .. } => Self::StartUnsafe,
-            PlanError::GoalUnsafe { .. } => Self::GoalUnsafe,
+            PlanError::GoalUnsafe { .. } | PlanError::GoalAvoided => Self::GoalUnsafe,
             PlanError::Disconnected { .. } => Self::Disconnected,
             PlanError::OutOfRegion { .. } => Self::OutOfRegion,
             _ => Self::Error,

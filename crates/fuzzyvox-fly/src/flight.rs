@@ -526,7 +526,7 @@ fn replan(
     let mut path = match plan_in_field_avoiding(field, start, goal, avoid) {
         // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
         // it (the known-safe frontier towards the goal), see more, and plan again there.
-        Err(PlanError::GoalUnsafe(_) | PlanError::Disconnected { .. }) => {
+        Err(PlanError::GoalUnsafe(_) | PlanError::GoalAvoided | PlanError::Disconnected { .. }) => {
             let target = nearest_reachable(field, start, goal, avoid)
                 .ok_or(PlanError::Disconnected { expanded: 0 })?;
             if resolution.center(target) == resolution.center(start) {

@@ -76,13 +76,13 @@ impl UnknownGuard {
         let mut suspects: Vec<usize> = self.suspects.iter().copied().collect();
         suspects.sort_unstable();
         for index in suspects {
-            let u = coordinates(index, dims);
+            let u = region.coordinates_at(index);
             for z in (u[2] - pad).max(0)..=(u[2] + pad).min(dims[2] as i64 - 1) {
                 for y in (u[1] - pad).max(0)..=(u[1] + pad).min(dims[1] as i64 - 1) {
                     for x in (u[0] - pad).max(0)..=(u[0] + pad).min(dims[0] as i64 - 1) {
                         let c = [x, y, z];
                         if squared(c, u) <= near {
-                            let i = dense(c, dims);
+                            let i = region.index_at(c);
                             if !self.forbidden[i] {
                                 self.forbidden[i] = true;
                                 self.marked.push(i);
@@ -97,7 +97,8 @@ impl UnknownGuard {
     /// Unknown voxels within `reach` voxels of an occupied or ambiguous voxel, within
     /// `radius` voxels of `centre` (region coordinates).
     fn add_suspects(&mut self, field: &CostField, centre: [i64; 3], radius: f64, reach: f64) {
-        let dims = field.region().dims();
+        let region = field.region();
+        let dims = region.dims();
         let r = radius.ceil() as i64;
         let lo: [i64; 3] = std::array::from_fn(|a| (centre[a] - r).max(0));
         let hi: [i64; 3] = std::array::from_fn(|a| (centre[a] + r).min(dims[a] as i64 - 1));
@@ -109,7 +110,7 @@ impl UnknownGuard {
                 for x in (lo[0] - s).max(0)..=(hi[0] + s).min(dims[0] as i64 - 1) {
                     let surface = [x, y, z];
                     if !matches!(
-                        field.class(dense(surface, dims)),
+                        field.class(region.index_at(surface)),
                         VoxelClass::Occupied | VoxelClass::Ambiguous
                     ) {
                         continue;
@@ -119,7 +120,7 @@ impl UnknownGuard {
                             for sx in (x - s).max(lo[0])..=(x + s).min(hi[0]) {
                                 let c = [sx, sy, sz];
                                 if squared(c, surface) <= within && squared(c, centre) <= ball {
-                                    let i = dense(c, dims);
+                                    let i = region.index_at(c);
                                     if field.class(i) == VoxelClass::Unknown {
                                         self.suspects.insert(i);
                                     }
@@ -141,18 +142,6 @@ impl UnknownGuard {
     pub fn suspects(&self) -> usize {
         self.suspects.len()
     }
-}
-
-fn coordinates(index: usize, dims: [usize; 3]) -> [i64; 3] {
-    [
-        (index % dims[0]) as i64,
-        ((index / dims[0]) % dims[1]) as i64,
-        (index / (dims[0] * dims[1])) as i64,
-    ]
-}
-
-fn dense(c: [i64; 3], dims: [usize; 3]) -> usize {
-    c[0] as usize + dims[0] * (c[1] as usize + dims[1] * c[2] as usize)
 }
 
 fn squared(a: [i64; 3], b: [i64; 3]) -> f64 {

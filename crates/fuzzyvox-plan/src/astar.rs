@@ -49,6 +49,10 @@ pub enum PlanError {
     /// The goal voxel cannot be entered; the [`Blocker`] says why.
     #[error("the goal is not safe: {0}")]
     GoalUnsafe(Blocker),
+    /// The goal is a voxel the caller asked the planner to avoid
+    /// ([`plan_in_field_avoiding`]).
+    #[error("the goal is one of the voxels the planner was asked to avoid")]
+    GoalAvoided,
     /// Start and goal are not connected through traversable voxels.
     #[error(
         "the goal is not connected to the start through safe space ({expanded} voxels searched)"
@@ -135,17 +139,30 @@ pub fn plan_in_field(
     start: VoxelKey,
     goal: VoxelKey,
 ) -> Result<Path, PlanError> {
-    plan_in_field_avoiding(field, start, goal, &|_| false)
+    search(field, start, goal, &|_| false)
 }
 
 /// [`plan_in_field`] that also never enters a voxel (dense index) for which `avoid` is true,
 /// the start excepted: a caller's restriction on top of the field, such as the closed loop's
 /// guard that keeps the vehicle out of unseen space near it. Shortcuts obey it too.
+///
+/// A goal it must avoid is refused with [`PlanError::GoalAvoided`].
 pub fn plan_in_field_avoiding(
     field: &CostField,
     start: VoxelKey,
     goal: VoxelKey,
     avoid: &dyn Fn(usize) -> bool,
+) -> Result<Path, PlanError> {
+    search(field, start, goal, avoid)
+}
+
+/// The A* of [`plan_in_field_avoiding`], generic over `avoid` so that [`plan_in_field`] pays
+/// nothing for it.
+fn search<A: Fn(usize) -> bool + ?Sized>(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+    avoid: &A,
 ) -> Result<Path, PlanError> {
     let region = field.region();
     let start_index = region
@@ -159,6 +176,9 @@ pub fn plan_in_field_avoiding(
     }
     if let Some(why) = field.blocker(goal_index) {
         return Err(PlanError::GoalUnsafe(why));
+    }
+    if goal_index != start_index && avoid(goal_index) {
+        return Err(PlanError::GoalAvoided);
     }
     // Metres of the shortest 26-connected route times the lowest rate: never more than the
     // true remaining cost, and consistent because every step costs at least its length times
@@ -221,7 +241,8 @@ pub fn plan_in_field_avoiding(
         voxels.push(region.key_at(node));
     }
     voxels.reverse();
-    let enter = |index: usize| field.is_traversable(index) && !avoid(index);
+    let enter =
+        |index: usize| field.is_traversable(index) && (index == start_index || !avoid(index));
     let corners = merge_collinear(field, &enter, &shortcut(field, &enter, &voxels));
     let resolution = field.resolution();
     let waypoints: Vec<Point3<f64>> = corners.iter().map(|k| resolution.center(*k)).collect();
@@ -389,6 +410,52 @@ mod tests {
             ..PlannerConfig::default()
         };
         CostField::build(&map, region, config).unwrap()
+    }
+
+    /// A wall of avoided voxels across the straight line bends the path around it; no
+    /// waypoint and no segment of the path enters an avoided voxel; an avoided goal is refused
+    /// as such; avoiding nothing gives `plan_in_field`'s path.
+    #[test]
+    fn avoided_voxels_bend_the_path_and_an_avoided_goal_is_refused() {
+        let field = open_field(false);
+        let region = *field.region();
+        let (start, goal) = (VoxelKey::new(5, 20, 10), VoxelKey::new(35, 20, 10));
+        let direct = plan_in_field(&field, start, goal).unwrap();
+        assert_eq!(direct.waypoints.len(), 2, "open space: one straight leg");
+        assert_eq!(
+            plan_in_field_avoiding(&field, start, goal, &|_| false)
+                .unwrap()
+                .waypoints,
+            direct.waypoints
+        );
+        // A 1.4 m wide plate at x = 2 m across the line, every z.
+        let wall = |index: usize| {
+            let [x, y, _] = region.coordinates_at(index);
+            x == 20 && (13..=27).contains(&y)
+        };
+        let path = plan_in_field_avoiding(&field, start, goal, &wall).unwrap();
+        assert!(
+            path.length > direct.length + 0.1,
+            "{} vs {}",
+            path.length,
+            direct.length
+        );
+        let resolution = field.resolution();
+        let corners: Vec<VoxelKey> = path
+            .waypoints
+            .iter()
+            .map(|p| resolution.key_of(p).unwrap())
+            .collect();
+        for leg in corners.windows(2) {
+            assert!(segment_voxels(&field, leg[0], leg[1], |i| !wall(i)));
+        }
+        let on_wall = VoxelKey::new(20, 20, 10);
+        assert!(matches!(
+            plan_in_field_avoiding(&field, start, on_wall, &wall),
+            Err(PlanError::GoalAvoided)
+        ));
+        // The start may be avoided: the vehicle is there already.
+        assert!(plan_in_field_avoiding(&field, on_wall, goal, &wall).is_ok());
     }
 
     fn traversable(field: &CostField) -> impl Fn(usize) -> bool + '_ {

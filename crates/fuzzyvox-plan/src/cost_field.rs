@@ -88,14 +88,14 @@ impl PlanningRegion {
     /// The dense index of the voxel at region coordinates `[x, y, z]` (each from 0 to its
     /// dimension, unchecked).
     #[inline]
-    pub(super) fn index_at(&self, [x, y, z]: [i64; 3]) -> usize {
+    pub fn index_at(&self, [x, y, z]: [i64; 3]) -> usize {
         let [nx, ny, _] = self.dims.map(|d| d as i64);
         (x + nx * (y + ny * z)) as usize
     }
 
     /// The region coordinates `[x, y, z]` of a dense index.
     #[inline]
-    pub(super) fn coordinates_at(&self, index: usize) -> [i64; 3] {
+    pub fn coordinates_at(&self, index: usize) -> [i64; 3] {
         let [nx, ny, _] = self.dims;
         [index % nx, (index / nx) % ny, index / (nx * ny)].map(|c| c as i64)
     }
