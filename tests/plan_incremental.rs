@@ -3,7 +3,9 @@
 
 use fuzzyvox::map::{AlphaConfig, AlphaCutMap, LogOddsConfig, LogOddsMap};
 use fuzzyvox::plan::{CostField, Planner, PlannerConfig, PlanningRegion, UnknownPolicy};
-use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelKey, VoxelMapMut};
+use fuzzyvox::{
+    FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelKey, VoxelMap, VoxelMapMut,
+};
 use nalgebra::{Point3, Vector3};
 
 /// A small deterministic generator (SplitMix64), so that the scans differ per seed.
@@ -124,6 +126,71 @@ fn updated_fuzzy_fields_equal_full_builds() {
     for seed in 1..4 {
         check(FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap(), seed);
     }
+}
+
+/// A fuzzy map that reports which blocks changed but keeps no stamps, so that the field's
+/// update decodes every voxel of the changed blocks (the path for such maps).
+struct Unstamped(FuzzyMap);
+
+impl VoxelMap for Unstamped {
+    fn resolution(&self) -> fuzzyvox::Resolution {
+        self.0.resolution()
+    }
+    fn measure_config(&self) -> &fuzzyvox::measures::MeasureConfig {
+        VoxelMap::measure_config(&self.0)
+    }
+    fn memberships_at(&self, key: VoxelKey) -> fuzzyvox::Memberships {
+        self.0.memberships_at(key)
+    }
+    fn block_memberships(
+        &self,
+        key: fuzzyvox::storage::BlockKey,
+        out: &mut [fuzzyvox::Memberships; fuzzyvox::storage::BLOCK_CELLS],
+    ) {
+        self.0.block_memberships(key, out);
+    }
+    fn counts(&self) -> fuzzyvox::map::VoxelCounts {
+        VoxelMap::counts(&self.0)
+    }
+    fn memory_bytes(&self) -> usize {
+        VoxelMap::memory_bytes(&self.0)
+    }
+    fn cells(&self) -> Box<dyn Iterator<Item = (VoxelKey, fuzzyvox::Memberships)> + '_> {
+        self.0.cells()
+    }
+    fn write_version(&self) -> Option<u64> {
+        self.0.write_version()
+    }
+    fn changed_blocks_since(&self, version: u64) -> Option<Vec<fuzzyvox::storage::BlockKey>> {
+        self.0.changed_blocks_since(version)
+    }
+}
+
+impl VoxelMapMut for Unstamped {
+    fn integrate_cloud(
+        &mut self,
+        cloud: &PointCloud,
+        options: &IntegrationOptions,
+    ) -> fuzzyvox::Result<fuzzyvox::IntegrationStats> {
+        self.0.integrate_cloud(cloud, options)
+    }
+    fn integrate_depth(
+        &mut self,
+        frame: &fuzzyvox::DepthFrame,
+        options: &IntegrationOptions,
+    ) -> fuzzyvox::Result<fuzzyvox::IntegrationStats> {
+        self.0.integrate_depth(frame, options)
+    }
+}
+
+#[test]
+fn updated_fields_of_a_map_without_stamps_equal_full_builds() {
+    let map = Unstamped(FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap());
+    assert!(!map.block_stamps(
+        fuzzyvox::storage::BlockKey::new(0, 0, 0),
+        &mut [0; fuzzyvox::storage::BLOCK_CELLS]
+    ));
+    check(map, 9);
 }
 
 #[test]
