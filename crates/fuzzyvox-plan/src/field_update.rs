@@ -72,12 +72,6 @@ impl CostField {
                 layer.update(map, &region, &rules, &measures, least, scratch)
             })
             .collect();
-        if std::env::var("ZZ").is_ok() {
-            eprintln!(
-                "layers {:?}",
-                outcomes.iter().map(|o| o.read).collect::<Vec<_>>()
-            );
-        }
         let mut flipped: Vec<VoxelBox> = Vec::new();
         for outcome in &outcomes {
             stats.voxels_read += outcome.read;
