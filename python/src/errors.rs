@@ -50,6 +50,8 @@ pub fn plan_error(error: PlanError) -> PyErr {
         PlanError::OutOfRegion(_) => "out_of_region",
         PlanError::StartUnsafe(_) => "start_unsafe",
         PlanError::GoalUnsafe(_) => "goal_unsafe",
+        // The Python planner avoids no voxels, so this one does not arise; named for completeness.
+        PlanError::GoalAvoided => "goal_avoided",
         PlanError::Disconnected { .. } => "disconnected",
         PlanError::Map(_) => return to_py(Error::from(error)),
     };
