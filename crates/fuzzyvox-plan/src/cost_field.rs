@@ -302,12 +302,13 @@ impl CostField {
         }
     }
 
-    /// Sets whether the voxel at `index` is traversable and its rate, from its class, safety
-    /// and clearance, keeping the least rate.
+    /// Sets whether the voxel at `index` is traversable and its rate under `rules` (the
+    /// field's own, [`CostField::rules`]), from its class, safety and clearance, keeping the
+    /// least rate.
     #[inline]
-    pub(super) fn derive(&mut self, i: usize) {
+    pub(super) fn derive(&mut self, i: usize, rules: &Rules) {
         let v = self.voxels[i];
-        let (traversable, rate) = self.entry(v.class, v.safety, v.clearance);
+        let (traversable, rate) = rules.entry(v.class, v.safety, v.clearance);
         self.least.replace(v.rate, rate);
         (self.voxels[i].traversable, self.voxels[i].rate) = (traversable, rate);
     }
@@ -319,12 +320,6 @@ impl CostField {
             required: self.required_clearance() as f32,
             preferred: self.config.preferred_clearance.max(1e-9) as f32,
         }
-    }
-
-    /// Whether a voxel of this class, safety and clearance is traversable, and its rate.
-    #[inline]
-    pub(super) fn entry(&self, class: VoxelClass, safety: f32, clearance: f32) -> (bool, f32) {
-        self.rules().entry(class, safety, clearance)
     }
 
     /// Finds the least rate again by scanning every voxel.

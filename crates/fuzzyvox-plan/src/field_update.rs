@@ -94,7 +94,7 @@ impl CostField {
             self.recompute_clearance(&target);
             for_each_voxel(&target, |x, y, z| {
                 stats.clearance_voxels += 1;
-                self.derive(region.index_at([x, y, z]));
+                self.derive(region.index_at([x, y, z]), &rules);
             });
         }
         if self.least.is_lost() {
