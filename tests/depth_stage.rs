@@ -150,6 +150,62 @@ fn forward_motion_is_matched_by_plane_sweep_with_honest_intervals() {
 /// Median `|P0 - truth|` and median interval width over the pixels with a bounded interval,
 /// and the share of those whose interval holds the true depth, for a depth frame in the
 /// camera `pose` looking at the textured plane.
+/// A surface straight ahead of a camera moving along its view: pixels a few degrees from the
+/// epipole move only a few pixels over the whole depth range (many planes per pixel of
+/// motion). The sweep measures them, with intervals that hold the truth, instead of dropping
+/// them as not unique; the epipole itself, which does not move, gets no depth.
+#[test]
+fn forward_motion_measures_pixels_near_the_epipole() {
+    let k = camera();
+    let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
+    let other_pose = pose([0.0, 0.0, -0.5], 0.0);
+    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 0.0).unwrap();
+    let other = Frame::new(render(&k, &other_pose), k, other_pose, 0.5).unwrap();
+    let params = DepthParams {
+        depth_range: Some((1.0, 60.0)),
+        forward_motion: ForwardMotion::PlaneSweep,
+        ..DepthParams::default()
+    };
+    let result = depth_from_pair(&reference, &other, &params).unwrap();
+    assert_eq!(result.method, MatchMethod::PlaneSweep);
+    let image = result.frame.image();
+    // The epipole: the other camera's centre seen from the reference camera.
+    let behind = reference_pose.inverse() * Point3::from(other_pose.translation.vector);
+    let epipole = k.project(&Point3::from(-behind.coords)).unwrap();
+    let (mut annulus, mut measured, mut inside, mut at_epipole) = (0usize, 0usize, 0usize, 0usize);
+    for i in 0..image.depth().len() {
+        let (u, v) = ((i % 320) as f64, (i / 320) as f64);
+        let radius = (u - epipole.x).hypot(v - epipole.y);
+        let depth = image.depth()[i];
+        if radius < 1.0 {
+            at_epipole += usize::from(depth.is_finite());
+        }
+        if !(8.0..30.0).contains(&radius) {
+            continue;
+        }
+        annulus += 1;
+        if !depth.is_finite() {
+            continue;
+        }
+        measured += 1;
+        let ray = reference_pose.rotation * k.back_project(u, v, 1.0).coords;
+        let truth = (reference_pose.inverse() * plane_hit(&Point3::origin(), &ray).unwrap()).z;
+        let (near, far) = (f64::from(image.near()[i]), f64::from(image.far()[i]));
+        inside += usize::from(near <= truth && (truth <= far || far.is_nan()));
+    }
+    let share = measured as f64 / annulus as f64;
+    assert!(
+        share > 0.5,
+        "{measured} of {annulus} pixels 8-30 px from the epipole measured"
+    );
+    let held = inside as f64 / measured as f64;
+    assert!(
+        held > 0.9,
+        "truth inside the interval for {held:.3} near the epipole"
+    );
+    assert_eq!(at_epipole, 0, "the epipole itself has no depth");
+}
+
 fn depth_errors(image: &fuzzyvox::IntervalDepthImage, pose: &Isometry3<f64>) -> (f32, f32, f64) {
     let k = camera();
     let origin = Point3::from(pose.translation.vector);

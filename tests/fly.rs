@@ -82,6 +82,7 @@ fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
     let config = FlyConfig {
         max_pitch: 0.0,
         weave_angle: 0.0,
+        look_turn: 0.0,
         ..FlyConfig::default()
     };
     let mut map = FlyModel::LogOdds.new_map(config.resolution).unwrap();
@@ -92,6 +93,72 @@ fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
     let last = log.trajectory.last().unwrap();
     assert!(last.z > 3.0, "{last:?}");
     assert!(plate.scene.distance_to_surface(last) >= config.planner.vehicle_radius);
+}
+
+/// A building face 4 m ahead of the start, across the way to a goal behind it: beyond the prior
+/// map, and straight ahead, where motion along the view measures almost nothing.
+fn wall_ahead() -> (Scenario, Goal) {
+    let mut scene = Scene::new();
+    scene.add_ground(0.013, 200.0).add_box(
+        Point3::new(4.5, 0.0, 3.0),
+        Vector3::new(0.3, 2.0, 3.0),
+        0.0,
+        SurfaceKind::Building,
+    );
+    let scenario = Scenario {
+        name: "wall ahead",
+        scene,
+        intrinsics: scenario::camera().unwrap(),
+        pairs: Vec::new(),
+        phases: Vec::new(),
+        max_range: 40.0,
+        extent: [[-10.0, -10.0], [10.0, 10.0]],
+        heights: [0.3, 7.0],
+        flight_altitude: (1.0, 6.0),
+        flight_distance: (2.0, 12.0),
+    };
+    let goal = Goal {
+        start: Point3::new(0.0, 0.3, 2.1),
+        goal: Point3::new(9.0, 0.3, 2.1),
+        truth_length: 12.0,
+    };
+    (scenario, goal)
+}
+
+#[test]
+fn looking_aside_at_take_off_sees_the_wall_that_forward_motion_misses() {
+    let (scenario, goal) = wall_ahead();
+    let fly = |look_turn: f64| {
+        let config = FlyConfig {
+            look_turn,
+            ..FlyConfig::default()
+        };
+        let mut map = FlyModel::Fuzzy.new_map(config.resolution).unwrap();
+        integrate_prior(&scenario, &mut map, &goal.start, &config).unwrap();
+        fly_goal(&scenario, &goal, &mut map, &config, 5).unwrap()
+    };
+    // Flying straight at it, the vehicle sees the face only from along its view and hits it.
+    let straight = fly(0.0);
+    assert_eq!(
+        straight.ending,
+        Ending::Collided,
+        "{:?}",
+        straight.trajectory
+    );
+    // One sideways step at take-off gives the depth stage a sideways baseline: the face is
+    // mapped and the vehicle goes round it, past the wall's far side, without touching it.
+    let looked = fly(FlyConfig::default().look_turn);
+    let first = looked.trajectory[1] - looked.trajectory[0];
+    assert!(
+        first.x.abs() < 1e-9 && first.y.abs() > 0.4,
+        "first step {first:?}"
+    );
+    assert_ne!(looked.ending, Ending::Collided, "{:?}", looked.trajectory);
+    assert!(
+        looked.trajectory.iter().any(|p| p.x > 5.0),
+        "{:?}",
+        looked.trajectory
+    );
 }
 
 #[test]
@@ -149,6 +216,15 @@ fn fly_reports_every_map_as_json() {
             "--unknown-cost",
         ),
         (&["fly", "--scenario", "nowhere"][..], "nowhere"),
+        (
+            &["fly", "--scenario", "wall", "--look-turn", "200"][..],
+            "look turn",
+        ),
+        (&["fly", "--scenario", "wall", "--weave", "95"][..], "weave"),
+        (
+            &["fly", "--scenario", "wall", "--guard=-1"][..],
+            "unknown guard",
+        ),
     ] {
         let run = fuzzyvox(args);
         assert!(!run.status.success(), "{args:?}");

@@ -45,6 +45,27 @@ pub struct FlyArgs {
     /// Extra cost per metre through unknown space; only with `--unknown cost` [default: 2].
     #[arg(long, value_name = "C")]
     unknown_cost: Option<f32>,
+    /// Weave: each step leaves the path's direction by this angle, degrees, to alternating
+    /// sides, so that what lies ahead is never at the epipole of the camera's motion [default:
+    /// 0, straight].
+    #[arg(long, value_name = "DEG")]
+    weave: Option<f64>,
+    /// The vehicle steps sideways to look ahead with a sideways baseline at take-off and after
+    /// every turn of the camera by more than this angle, degrees [default: 45; 0 turns it off].
+    #[arg(long, value_name = "DEG")]
+    look_turn: Option<f64>,
+    /// The camera pitches towards the point ahead by at most this angle, degrees [default: 30;
+    /// 0 keeps it level].
+    #[arg(long, value_name = "DEG")]
+    pitch: Option<f64>,
+    /// The camera turns at most this fast, degrees per second [default: 720, no limit at the
+    /// default frame rate].
+    #[arg(long, value_name = "DEG_PER_S")]
+    yaw_rate: Option<f64>,
+    /// The unseen-surface guard's reach, metres: unknown voxels next to seen surfaces within
+    /// this distance of the vehicle are never entered [default: 0, off].
+    #[arg(long, value_name = "M")]
+    guard: Option<f64>,
     /// Write fly.json and a top-down figure of each flight over its final map here.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -80,9 +101,15 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
     if args.goals == 0 {
         bail!("--goals must be at least 1");
     }
+    let defaults = FlyConfig::default();
     let mut config = FlyConfig {
         views: args.views as usize,
-        ..FlyConfig::default()
+        weave_angle: args.weave.unwrap_or(defaults.weave_angle),
+        max_pitch: args.pitch.unwrap_or(defaults.max_pitch),
+        look_turn: args.look_turn.unwrap_or(defaults.look_turn),
+        max_yaw_rate: args.yaw_rate.unwrap_or(defaults.max_yaw_rate),
+        unknown_guard: args.guard.unwrap_or(defaults.unknown_guard),
+        ..defaults
     };
     config.planner.unknown = match (args.unknown, args.unknown_cost) {
         (Unknown::Cost, cost) => UnknownPolicy::Cost(cost.unwrap_or(2.0)),

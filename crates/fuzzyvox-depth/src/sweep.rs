@@ -17,10 +17,16 @@
 //! [`StereoGeometry`] with `baseline · f = 1 / Δw` and `doffs = w_far / Δw`: the interval and
 //! confidence code of rectified pairs applies unchanged.
 //!
-//! Near the epipole the planes barely move a pixel, the cost curve is flat and the uniqueness
-//! test drops the pixel, or its cost-curve interval is wide and its confidence low: the honest
-//! answer for motion along the view. There is no left-right check (the other image has no
-//! sweep of its own).
+//! Near the epipole the planes barely move a pixel: one plane step is one pixel only where the
+//! image moves fastest, so a pixel that moves `m` pixels over the whole sweep keeps the same
+//! nearest pixel, and so the same cost, for about `planes / m` planes in a row. Its minimum is
+//! then a run of equal costs: the match is the run's middle, and the uniqueness test looks for
+//! rivals more than one pixel *of that pixel's motion* beyond the run (not one plane, which
+//! would find the run itself and drop every slow pixel). Its cost-curve range spans the run, so
+//! its interval is as wide as one pixel of motion makes it and its confidence follows. A pixel
+//! that moves less than [`MIN_SWEEP_MOTION`] pixels over the whole depth range (the epipole
+//! itself) cannot be measured and gets no depth: the honest answer for motion along the view.
+//! There is no left-right check (the other image has no sweep of its own).
 //!
 //! Memory is bounded by a band of rows times the planes: the image is cut into bands of rows
 //! that threads sweep independently (each band with a halo of half a window), keeping the
@@ -54,6 +60,10 @@ pub const MAX_SWEEP_SIDE: u32 = 1 << 20;
 /// Most pixels of a view the sweep matches against: a pixel's index in it must fit an `i32`
 /// (the landing loop's `-1` marks "outside").
 pub const MAX_SWEEP_PIXELS: u64 = (1 << 31) - 1;
+
+/// A pixel that moves less than this many pixels, in its fastest view, between the nearest and
+/// the farthest plane gets no depth: its cost curve cannot tell depths apart.
+pub const MIN_SWEEP_MOTION: f32 = 2.0;
 
 /// Most other views one sweep matches against (a pixel's cost sums and counts stay small).
 pub const MAX_SWEEP_VIEWS: usize = 16;
@@ -201,6 +211,46 @@ impl Sweep {
         }
         for ((cost, &sum), &count) in out.iter_mut().zip(sums.iter()).zip(counts.iter()) {
             *cost = mean_cost(sum, count);
+        }
+    }
+}
+
+impl Sweep {
+    /// Each pixel's rival exclusion (see [`PixelState::exclusion`]) for one reference row:
+    /// how far the pixel moves, in its fastest view, from the farthest to the nearest plane
+    /// (summed over eight legs, so that motion that turns is not undercounted), turned into the
+    /// number of planes per pixel of motion.
+    fn exclusions(&self, rays: RowRays<'_>, row: &mut [PixelState]) {
+        const LEGS: u32 = 8;
+        let last = f64::from(self.planes - 1);
+        let landing = |ax: f32, ay: f32, az: f32, b: [f32; 3], inverse: f32| {
+            let qz = az + b[2] * inverse;
+            (qz > 1e-6).then(|| ((ax + b[0] * inverse) / qz, (ay + b[1] * inverse) / qz))
+        };
+        for (x, s) in row.iter_mut().enumerate() {
+            let mut motion = 0.0f32;
+            for (v, view) in self.views.iter().enumerate() {
+                let (xs, ys, zs) = rays.view(v);
+                let (ax, ay, az) = (xs[x], ys[x], zs[x]);
+                let mut moved = 0.0f32;
+                let mut previous = None;
+                for leg in 0..=LEGS {
+                    let k = last * f64::from(leg) / f64::from(LEGS);
+                    let inverse = (self.inverse_far + self.step * k) as f32;
+                    let here = landing(ax, ay, az, view.translation, inverse);
+                    if let (Some(a), Some(b)) = (previous, here) {
+                        let (a, b): ((f32, f32), (f32, f32)) = (a, b);
+                        moved += (b.0 - a.0).hypot(b.1 - a.1);
+                    }
+                    previous = here;
+                }
+                motion = motion.max(moved);
+            }
+            s.exclusion = if motion.is_finite() && motion >= MIN_SWEEP_MOTION {
+                ((last as f32 / motion).ceil() as u32).max(1)
+            } else {
+                u32::MAX
+            };
         }
     }
 }
@@ -447,7 +497,12 @@ impl SweepView {
 #[derive(Clone, Copy)]
 struct PixelState {
     best: u16,
+    /// First and last plane of the run of equal best costs (see the module's documentation).
     best_plane: u32,
+    run_end: u32,
+    /// Planes on either side of the run within which a cost is no rival: one pixel of this
+    /// pixel's motion; `u32::MAX` when the pixel barely moves (no depth).
+    exclusion: u32,
     left: u16,
     right: u16,
     runner_up: u16,
@@ -460,6 +515,8 @@ impl Default for PixelState {
         Self {
             best: u16::MAX,
             best_plane: 0,
+            run_end: 0,
+            exclusion: 1,
             left: u16::MAX,
             right: u16::MAX,
             runner_up: u16::MAX,
@@ -586,18 +643,26 @@ fn sweep_band(
     }
     let mut previous = vec![u16::MAX; n];
     let mut state = vec![PixelState::default(); n];
-    // Pass 1: the best plane and the costs on either side of it.
+    for (r, row) in state.chunks_exact_mut(width).enumerate() {
+        sweep.exclusions(rays.row(y0 - first + r), row);
+    }
+    // Pass 1: the best run of planes and the costs on either side of it.
     for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
         for ((s, &c), &p) in state.iter_mut().zip(costs).zip(&previous) {
             if c < s.best {
-                (s.best, s.best_plane, s.left, s.right) = (c, k, p, u16::MAX);
-            } else if k == s.best_plane + 1 && s.best != u16::MAX {
-                s.right = c;
+                (s.best, s.best_plane, s.run_end, s.left, s.right) = (c, k, k, p, u16::MAX);
+            } else if k == s.run_end + 1 && s.best != u16::MAX {
+                if c == s.best && s.right == u16::MAX {
+                    s.run_end = k;
+                } else if s.right == u16::MAX {
+                    s.right = c;
+                }
             }
         }
         previous.copy_from_slice(costs);
     }
-    // Pass 2: the best cost more than one plane away, and the cost-curve range.
+    // Pass 2: the best cost more than one pixel of motion beyond the run, and the cost-curve
+    // range.
     let tolerance = 1.0 + f64::from(params.range_tolerance);
     let limits: Vec<u16> = state
         .iter()
@@ -605,7 +670,9 @@ fn sweep_band(
         .collect();
     for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
         for ((s, &c), &limit) in state.iter_mut().zip(costs).zip(&limits) {
-            if k.abs_diff(s.best_plane) > 1 {
+            let before = s.best_plane.saturating_sub(k);
+            let after = k.saturating_sub(s.run_end);
+            if before.max(after) > s.exclusion {
                 s.runner_up = s.runner_up.min(c);
             }
             if c <= limit {
@@ -664,14 +731,19 @@ pub(crate) fn sweep_views(
         u32::from(CENSUS_MAX_COST) * COST_SCALE * params.window_width * params.window_height;
     let ratio = params.uniqueness_ratio;
     for (i, s) in states.iter().flatten().enumerate() {
-        if s.best == u16::MAX || u32::from(s.best) >= max_cost || s.low > s.high {
+        if s.best == u16::MAX
+            || u32::from(s.best) >= max_cost
+            || s.low > s.high
+            || s.exclusion == u32::MAX
+        {
             continue;
         }
         if ratio > 0 && u32::from(s.runner_up) * (100 - ratio) < u32::from(s.best) * 100 {
             continue;
         }
-        let mut offset = 0.0f32;
-        if s.left != u16::MAX && s.right != u16::MAX {
+        // A run's middle; a single best plane is refined by a parabola through its neighbours.
+        let mut offset = (s.run_end - s.best_plane) as f32 / 2.0;
+        if s.run_end == s.best_plane && s.left != u16::MAX && s.right != u16::MAX {
             let (l, b, r) = (f32::from(s.left), f32::from(s.best), f32::from(s.right));
             let curvature = l + r - 2.0 * b;
             if curvature > 0.0 {

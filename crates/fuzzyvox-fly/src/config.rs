@@ -44,14 +44,20 @@ pub struct FlyConfig {
     /// Default 720 (180° per frame at the default frame interval: no limit).
     pub max_yaw_rate: f64,
     /// The camera pitches towards the point ahead when the path climbs or descends, at most
-    /// this many degrees up or down (turning at the yaw rate's limit). Default 0 (a level
-    /// camera).
+    /// this many degrees up or down (turning at the yaw rate's limit), so that it sees what a
+    /// climb or descent flies into (a level camera does not see the top of a box the path
+    /// crosses). 0 keeps the camera level. Default 30.
     pub max_pitch: f64,
     /// The vehicle weaves: each step leaves the direction of the path's next waypoint by this
     /// angle, degrees, to the left and then to the right, so that what lies straight ahead on
     /// the path is never at the epipole of the camera's motion (where depth from motion is
     /// undefined). 0 flies straight. Default 0.
     pub weave_angle: f64,
+    /// The vehicle looks aside before it flies into what it has not seen: at take-off, and
+    /// whenever the camera has turned by more than this angle, degrees, since it last did, its
+    /// next step goes sideways instead of along the path, so that the view ahead gets a
+    /// sideways baseline. 0 turns it off. Default 45.
+    pub look_turn: f64,
     /// Frames between changes of the weaving side. Default 2.
     pub weave_frames: usize,
     /// The planner keeps its path while it stays valid, but replans at least every this many
@@ -95,7 +101,8 @@ impl Default for FlyConfig {
             look_ahead: 3.0,
             max_yaw_rate: 720.0,
             weave_angle: 0.0,
-            max_pitch: 0.0,
+            max_pitch: 30.0,
+            look_turn: 45.0,
             weave_frames: 2,
             replan_every: 8,
             unknown_guard: 0.0,
@@ -156,6 +163,13 @@ impl FlyConfig {
                     expected: "an angle from 0 to 80 degrees",
                 });
             }
+        }
+        if !(0.0..=180.0).contains(&self.look_turn) {
+            return Err(Error::InvalidParameter {
+                name: "look turn",
+                value: self.look_turn,
+                expected: "an angle from 0 to 180 degrees",
+            });
         }
         if self.weave_frames == 0 {
             return Err(Error::InvalidParameter {

@@ -168,6 +168,9 @@ pub struct Flight<'a> {
     pitch: f64,
     since_plan: usize,
     stalled: usize,
+    /// The camera's heading when the vehicle last side-stepped to look ahead (`None` before
+    /// the first look).
+    looked: Option<Vector3<f64>>,
     frame_index: usize,
     max_frames: usize,
     ending: Option<Ending>,
@@ -211,6 +214,7 @@ impl<'a> Flight<'a> {
             pitch: 0.0,
             since_plan: 0,
             stalled: 0,
+            looked: None,
             frame_index: 0,
             max_frames: (config.time_limit / config.frame_interval).ceil() as usize,
             ending: None,
@@ -401,10 +405,15 @@ impl<'a> Flight<'a> {
         let step = self.config.step();
         let position = self.position;
         let weave = self.path.as_deref().and_then(|p| self.weave(p, step));
+        let look = if self.path.as_ref().is_some_and(|p| !p.is_empty()) {
+            self.look_aside(step)
+        } else {
+            None
+        };
         let next = match self.path.as_mut() {
             Some(current) if !current.is_empty() => {
                 self.stalled = 0;
-                match weave {
+                match look.or(weave) {
                     Some(next) => {
                         current[0] = next;
                         next
@@ -479,6 +488,36 @@ impl<'a> Flight<'a> {
                 self.guard.forbids(i)
             })
             .then_some(next)
+    }
+
+    /// The look-aside step: at take-off, and whenever the camera has turned by more than
+    /// [`FlyConfig::look_turn`] since the last look, the vehicle steps `step` metres sideways
+    /// (left, or right when the map does not hold the left step clear) instead of along its
+    /// path, so that the next depth image of what lies ahead comes from a sideways baseline
+    /// (rectified stereo, the best geometry) rather than from motion along the view, which
+    /// measures nothing at the epipole, exactly where the vehicle is going. `None` when the
+    /// look is off or not due, or neither side is clear.
+    fn look_aside(&mut self, step: f64) -> Option<Point3<f64>> {
+        let turn = self.config.look_turn;
+        if turn <= 0.0 {
+            return None;
+        }
+        let due = self
+            .looked
+            .is_none_or(|h| h.angle(&self.heading) > turn.to_radians());
+        if !due {
+            return None;
+        }
+        let aside = self.heading.cross(&Vector3::z()) * step;
+        let clear = |next: Point3<f64>| {
+            self.planner
+                .is_clear_avoiding(&[self.position, next], &|i| self.guard.forbids(i))
+        };
+        let next = [self.position + aside, self.position - aside]
+            .into_iter()
+            .find(|&next| clear(next))?;
+        self.looked = Some(self.heading);
+        Some(next)
     }
 
     fn finish(&mut self, ending: Ending) {
