@@ -247,7 +247,7 @@ impl Sweep {
                 motion = motion.max(moved);
             }
             s.exclusion = if motion.is_finite() && motion >= MIN_SWEEP_MOTION {
-                ((last as f32 / motion).ceil() as u32).max(1)
+                ((last as f32 / motion).round() as u32).max(1)
             } else {
                 u32::MAX
             };
@@ -652,7 +652,7 @@ fn sweep_band(
             if c < s.best {
                 (s.best, s.best_plane, s.run_end, s.left, s.right) = (c, k, k, p, u16::MAX);
             } else if k == s.run_end + 1 && s.best != u16::MAX {
-                if c == s.best && s.right == u16::MAX {
+                if c == s.best && s.right == u16::MAX && s.exclusion > 1 {
                     s.run_end = k;
                 } else if s.right == u16::MAX {
                     s.right = c;

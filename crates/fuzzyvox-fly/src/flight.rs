@@ -38,6 +38,11 @@ pub enum Ending {
 /// voxel or one that touches it).
 pub const REACHED_VOXELS: f64 = 1.732_050_807_568_877_2;
 
+/// Frames after a look aside before the next one: a path that swings from side to side
+/// (around an obstacle, or while the map fills in) would otherwise send the vehicle sideways
+/// every frame.
+pub const LOOK_FRAMES: usize = 4;
+
 /// Frames in a row without a path after which a flight gives up.
 pub const STALL_FRAMES: usize = 12;
 
@@ -171,6 +176,8 @@ pub struct Flight<'a> {
     /// The camera's heading when the vehicle last side-stepped to look ahead (`None` before
     /// the first look).
     looked: Option<Vector3<f64>>,
+    /// The frame of the last look aside.
+    looked_at: usize,
     frame_index: usize,
     max_frames: usize,
     ending: Option<Ending>,
@@ -215,6 +222,7 @@ impl<'a> Flight<'a> {
             since_plan: 0,
             stalled: 0,
             looked: None,
+            looked_at: 0,
             frame_index: 0,
             max_frames: (config.time_limit / config.frame_interval).ceil() as usize,
             ending: None,
@@ -385,11 +393,16 @@ impl<'a> Flight<'a> {
             && self
                 .path
                 .as_deref()
-                .is_some_and(|p| self.planner.is_clear_avoiding(p, &avoid));
+                .is_some_and(|p| p.len() >= 2 && self.planner.is_clear_avoiding(p, &avoid));
         if keep {
             self.since_plan += 1;
         } else {
-            self.path = replan(self.planner.field(), self.position, self.goal_key, &avoid).ok();
+            // A path that goes nowhere (the vehicle's own voxel is the nearest it can reach) is
+            // no path: the vehicle side-steps to look, and gives up after `STALL_FRAMES`, instead
+            // of hovering on it until the time runs out.
+            self.path = replan(self.planner.field(), self.position, self.goal_key, &avoid)
+                .ok()
+                .filter(|p| p.len() >= 2);
             self.log.replans += 1;
             self.since_plan = 0;
         }
@@ -431,6 +444,8 @@ impl<'a> Flight<'a> {
                     return;
                 }
                 self.heading = level(self.goal.goal - position).unwrap_or(self.heading);
+                // These side-steps look at the goal with a sideways baseline: a look.
+                self.looked = Some(self.heading);
                 let sign = if self.stalled % 2 == 1 { 1.0 } else { -1.0 };
                 let next = position + self.heading.cross(&Vector3::z()) * sign * (0.6 * step);
                 if !self
@@ -491,7 +506,8 @@ impl<'a> Flight<'a> {
     }
 
     /// The look-aside step: at take-off, and whenever the camera has turned by more than
-    /// [`FlyConfig::look_turn`] since the last look, the vehicle steps `step` metres sideways
+    /// [`FlyConfig::look_turn`] since the last look (at least [`LOOK_FRAMES`] frames before;
+    /// the side-steps of a vehicle without a path count as looks), the vehicle steps `step` metres sideways
     /// (left, or right when the map does not hold the left step clear) instead of along its
     /// path, so that the next depth image of what lies ahead comes from a sideways baseline
     /// (rectified stereo, the best geometry) rather than from motion along the view, which
@@ -502,9 +518,10 @@ impl<'a> Flight<'a> {
         if turn <= 0.0 {
             return None;
         }
-        let due = self
-            .looked
-            .is_none_or(|h| h.angle(&self.heading) > turn.to_radians());
+        let due = self.looked.is_none_or(|h| {
+            h.angle(&self.heading) > turn.to_radians()
+                && self.frame_index >= self.looked_at + LOOK_FRAMES
+        });
         if !due {
             return None;
         }
@@ -517,6 +534,7 @@ impl<'a> Flight<'a> {
             .into_iter()
             .find(|&next| clear(next))?;
         self.looked = Some(self.heading);
+        self.looked_at = self.frame_index;
         Some(next)
     }
 

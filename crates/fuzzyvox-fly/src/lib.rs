@@ -42,7 +42,7 @@ pub mod report;
 use serde::Serialize;
 
 pub use config::FlyConfig;
-pub use flight::{CycleTimes, Ending, Flight, FlightLog, fly_goal, integrate_prior};
+pub use flight::{CycleTimes, Ending, Flight, FlightLog, LOOK_FRAMES, fly_goal, integrate_prior};
 pub use goals::{Goal, draw_goals, planning_region, truth_map};
 pub use guard::UnknownGuard;
 pub use report::{flight_figure, flights_json, flights_markdown, write_flight_figures};
