@@ -444,7 +444,8 @@ impl<'a> Flight<'a> {
                     return;
                 }
                 self.heading = level(self.goal.goal - position).unwrap_or(self.heading);
-                // These side-steps look at the goal with a sideways baseline: a look.
+                // These side-steps look at the goal with a sideways baseline: the next look
+                // aside is due when the camera turns away from this heading.
                 self.looked = Some(self.heading);
                 let sign = if self.stalled % 2 == 1 { 1.0 } else { -1.0 };
                 let next = position + self.heading.cross(&Vector3::z()) * sign * (0.6 * step);
@@ -506,10 +507,10 @@ impl<'a> Flight<'a> {
     }
 
     /// The look-aside step: at take-off, and whenever the camera has turned by more than
-    /// [`FlyConfig::look_turn`] since the last look (at least [`LOOK_FRAMES`] frames before;
-    /// the side-steps of a vehicle without a path count as looks), the vehicle steps `step` metres sideways
-    /// (left, or right when the map does not hold the left step clear) instead of along its
-    /// path, so that the next depth image of what lies ahead comes from a sideways baseline
+    /// [`FlyConfig::look_turn`] since the last look (and at least [`LOOK_FRAMES`] frames after
+    /// it; the side-steps of a vehicle without a path, which look at the goal, set the heading
+    /// a look compares with), the vehicle steps `step` metres sideways (left, or right when
+    /// the map does not hold the left step clear) instead of along its path, so that the next depth image of what lies ahead comes from a sideways baseline
     /// (rectified stereo, the best geometry) rather than from motion along the view, which
     /// measures nothing at the epipole, exactly where the vehicle is going. `None` when the
     /// look is off or not due, or neither side is clear.
