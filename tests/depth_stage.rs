@@ -56,6 +56,11 @@ fn render(k: &PinholeIntrinsics, pose: &Isometry3<f64>) -> GrayImage {
     GrayImage::new(k.width(), k.height(), pixels).unwrap()
 }
 
+/// The textured plane seen from `pose` at `time`.
+fn view(k: &PinholeIntrinsics, pose: Isometry3<f64>, time: f64) -> Frame {
+    Frame::new(render(k, &pose), *k, pose, time).unwrap()
+}
+
 fn pose(position: [f64; 3], yaw_degrees: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(position[0], position[1], position[2]),
@@ -69,8 +74,8 @@ fn forward_motion_is_matched_by_plane_sweep_with_honest_intervals() {
     let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
     // Half a metre back along the view: the epipole sits near the image centre.
     let other_pose = pose([0.01, 0.0, -0.5], 0.0);
-    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 0.0).unwrap();
-    let other = Frame::new(render(&k, &other_pose), k, other_pose, 0.5).unwrap();
+    let reference = view(&k, reference_pose, 0.0);
+    let other = view(&k, other_pose, 0.5);
     let mut params = DepthParams {
         depth_range: Some((2.0, 12.0)),
         ..DepthParams::default()
@@ -147,9 +152,6 @@ fn forward_motion_is_matched_by_plane_sweep_with_honest_intervals() {
     ));
 }
 
-/// Median `|P0 - truth|` and median interval width over the pixels with a bounded interval,
-/// and the share of those whose interval holds the true depth, for a depth frame in the
-/// camera `pose` looking at the textured plane.
 /// A surface straight ahead of a camera moving along its view: pixels a few degrees from the
 /// epipole move only a few pixels over the whole depth range (many planes per pixel of
 /// motion). The sweep measures them, with intervals that hold the truth, instead of dropping
@@ -159,8 +161,8 @@ fn forward_motion_measures_pixels_near_the_epipole() {
     let k = camera();
     let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
     let other_pose = pose([0.0, 0.0, -0.5], 0.0);
-    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 0.0).unwrap();
-    let other = Frame::new(render(&k, &other_pose), k, other_pose, 0.5).unwrap();
+    let reference = view(&k, reference_pose, 0.0);
+    let other = view(&k, other_pose, 0.5);
     let params = DepthParams {
         depth_range: Some((1.0, 60.0)),
         forward_motion: ForwardMotion::PlaneSweep,
@@ -206,6 +208,9 @@ fn forward_motion_measures_pixels_near_the_epipole() {
     assert_eq!(at_epipole, 0, "the epipole itself has no depth");
 }
 
+/// Median `|P0 - truth|` and median interval width over the pixels with a bounded interval,
+/// and the share of those whose interval holds the true depth, for a depth frame in the
+/// camera `pose` looking at the textured plane.
 fn depth_errors(image: &fuzzyvox::IntervalDepthImage, pose: &Isometry3<f64>) -> (f32, f32, f64) {
     let k = camera();
     let origin = Point3::from(pose.translation.vector);
@@ -320,8 +325,8 @@ fn synthetic_plane_depth_lies_in_the_interval() {
     let k = camera();
     let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
     let other_pose = pose([0.35, 0.02, 0.03], -2.0);
-    let reference = Frame::new(render(&k, &reference_pose), k, reference_pose, 0.0).unwrap();
-    let other = Frame::new(render(&k, &other_pose), k, other_pose, 0.5).unwrap();
+    let reference = view(&k, reference_pose, 0.0);
+    let other = view(&k, other_pose, 0.5);
     for method in [
         IntervalMethod::FixedDelta { delta: 1.0 },
         IntervalMethod::CostCurve { delta: 1.0 },

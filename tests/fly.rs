@@ -49,24 +49,30 @@ fn a_flight_is_the_same_for_the_same_seed() {
 /// A 10 × 10 m plate 2.5 m under the start, which a level camera never sees (it lies below the
 /// camera's view at every distance the plate reaches), over a goal beneath it.
 fn hidden_plate() -> Scenario {
-    let mut scene = Scene::new();
-    scene.add_ground(0.013, 200.0).add_box(
+    one_box(
+        "plate",
         Point3::new(0.0, 0.0, 3.0),
         Vector3::new(5.0, 5.0, 0.05),
-        0.0,
-        SurfaceKind::Building,
-    );
+    )
+}
+
+/// Flat ground with one building box (`centre`, half extents `half`), 20 m across.
+fn one_box(name: &'static str, centre: Point3<f64>, half: Vector3<f64>) -> Scenario {
+    let mut scene = Scene::new();
+    scene
+        .add_ground(0.013, 200.0)
+        .add_box(centre, half, 0.0, SurfaceKind::Building);
     Scenario {
-        name: "plate",
+        name,
         scene,
         intrinsics: scenario::camera().unwrap(),
         pairs: Vec::new(),
         phases: Vec::new(),
         max_range: 40.0,
         extent: [[-10.0, -10.0], [10.0, 10.0]],
-        heights: [0.3, 6.0],
+        heights: [0.3, 7.0],
         flight_altitude: (1.0, 6.0),
-        flight_distance: (2.0, 10.0),
+        flight_distance: (2.0, 12.0),
     }
 }
 
@@ -98,25 +104,11 @@ fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
 /// A building face 4 m ahead of the start, across the way to a goal behind it: beyond the prior
 /// map, and straight ahead, where motion along the view measures almost nothing.
 fn wall_ahead() -> (Scenario, Goal) {
-    let mut scene = Scene::new();
-    scene.add_ground(0.013, 200.0).add_box(
+    let scenario = one_box(
+        "wall ahead",
         Point3::new(4.5, 0.0, 3.0),
         Vector3::new(0.3, 2.0, 3.0),
-        0.0,
-        SurfaceKind::Building,
     );
-    let scenario = Scenario {
-        name: "wall ahead",
-        scene,
-        intrinsics: scenario::camera().unwrap(),
-        pairs: Vec::new(),
-        phases: Vec::new(),
-        max_range: 40.0,
-        extent: [[-10.0, -10.0], [10.0, 10.0]],
-        heights: [0.3, 7.0],
-        flight_altitude: (1.0, 6.0),
-        flight_distance: (2.0, 12.0),
-    };
     let goal = Goal {
         start: Point3::new(0.0, 0.3, 2.1),
         goal: Point3::new(9.0, 0.3, 2.1),

@@ -213,33 +213,26 @@ impl Sweep {
             *cost = mean_cost(sum, count);
         }
     }
-}
 
-impl Sweep {
     /// Each pixel's rival exclusion (see [`PixelState::exclusion`]) for one reference row:
     /// how far the pixel moves, in its fastest view, from the farthest to the nearest plane
     /// (summed over eight legs, so that motion that turns is not undercounted), turned into the
-    /// number of planes per pixel of motion.
+    /// number of planes per pixel of motion, rounded (a pixel that moves about a pixel per plane
+    /// keeps the one-plane bound of rectified rows).
     fn exclusions(&self, rays: RowRays<'_>, row: &mut [PixelState]) {
         const LEGS: u32 = 8;
         let last = f64::from(self.planes - 1);
-        let landing = |ax: f32, ay: f32, az: f32, b: [f32; 3], inverse: f32| {
-            let qz = az + b[2] * inverse;
-            (qz > 1e-6).then(|| ((ax + b[0] * inverse) / qz, (ay + b[1] * inverse) / qz))
-        };
         for (x, s) in row.iter_mut().enumerate() {
             let mut motion = 0.0f32;
             for (v, view) in self.views.iter().enumerate() {
                 let (xs, ys, zs) = rays.view(v);
-                let (ax, ay, az) = (xs[x], ys[x], zs[x]);
+                let ray = [xs[x], ys[x], zs[x]];
                 let mut moved = 0.0f32;
-                let mut previous = None;
+                let mut previous: Option<(f32, f32)> = None;
                 for leg in 0..=LEGS {
                     let k = last * f64::from(leg) / f64::from(LEGS);
-                    let inverse = (self.inverse_far + self.step * k) as f32;
-                    let here = landing(ax, ay, az, view.translation, inverse);
+                    let here = view.landing(ray, (self.inverse_far + self.step * k) as f32);
                     if let (Some(a), Some(b)) = (previous, here) {
-                        let (a, b): ((f32, f32), (f32, f32)) = (a, b);
                         moved += (b.0 - a.0).hypot(b.1 - a.1);
                     }
                     previous = here;
@@ -401,6 +394,15 @@ impl<'a> RowRays<'a> {
 }
 
 impl SweepView {
+    /// Where a reference pixel whose ray is `ray` (`M x̃`) lands in this view on the plane of
+    /// inverse depth `inverse`, unrounded; `None` behind the view's camera. (The sweep's cost
+    /// loop does the same, branch-free and rounded to the nearest pixel.)
+    fn landing(&self, ray: [f32; 3], inverse: f32) -> Option<(f32, f32)> {
+        let b = self.translation.map(|t| t * inverse);
+        let qz = ray[2] + b[2];
+        (qz > 1e-6).then(|| ((ray[0] + b[0]) / qz, (ray[1] + b[1]) / qz))
+    }
+
     /// The view of `other` from `reference` and the fastest image motion per unit of inverse
     /// depth over the swept range (sampled over a grid of pixels and depths).
     fn new(
