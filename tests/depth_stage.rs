@@ -208,6 +208,44 @@ fn forward_motion_measures_pixels_near_the_epipole() {
     assert_eq!(at_epipole, 0, "the epipole itself has no depth");
 }
 
+#[test]
+fn a_pair_with_the_epipole_just_outside_the_image_is_swept() {
+    let k = camera();
+    let reference_pose = pose([0.0, 0.0, 0.0], 0.0);
+    // Behind and above the reference (y points down): the other camera's centre projects 80 px
+    // below the 240 px image, so the views look nearly along the baseline.
+    let other_pose = pose([0.0, -0.2, -0.3], 0.0);
+    let reference = view(&k, reference_pose, 0.0);
+    let other = view(&k, other_pose, 0.5);
+    let params = |forward_motion| DepthParams {
+        depth_range: Some((1.0, 60.0)),
+        forward_motion,
+        ..DepthParams::default()
+    };
+    // Rectification accepts the pair (the epipole is outside the image) ...
+    let rectified = depth_from_pair(&reference, &other, &params(ForwardMotion::Reject)).unwrap();
+    assert_eq!(rectified.method, MatchMethod::Rectified);
+    // ... but where the plane sweep is allowed, the pair goes to it.
+    let result = depth_from_pair(&reference, &other, &params(ForwardMotion::PlaneSweep)).unwrap();
+    assert_eq!(result.method, MatchMethod::PlaneSweep);
+    let image = result.frame.image();
+    let (mut measured, mut inside) = (0usize, 0usize);
+    for i in 0..image.depth().len() {
+        if !image.depth()[i].is_finite() {
+            continue;
+        }
+        measured += 1;
+        let (u, v) = ((i % 320) as f64, (i / 320) as f64);
+        let ray = reference_pose.rotation * k.back_project(u, v, 1.0).coords;
+        let truth = (reference_pose.inverse() * plane_hit(&Point3::origin(), &ray).unwrap()).z;
+        let (near, far) = (f64::from(image.near()[i]), f64::from(image.far()[i]));
+        inside += usize::from(near <= truth && (truth <= far || far.is_nan()));
+    }
+    assert!(measured > 320 * 240 / 2, "{measured} pixels measured");
+    let held = inside as f64 / measured as f64;
+    assert!(held > 0.9, "truth inside the interval for {held:.3}");
+}
+
 /// Median `|P0 - truth|` and median interval width over the pixels with a bounded interval,
 /// and the share of those whose interval holds the true depth, for a depth frame in the
 /// camera `pose` looking at the textured plane.

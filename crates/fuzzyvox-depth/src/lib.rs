@@ -51,8 +51,9 @@ pub use matching::match_pair;
 pub use metrics::{Accuracy, evaluate};
 pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
 pub use pipeline::{
-    DepthParams, DepthResult, ForwardMotion, MatchMethod, depth_by_plane_sweep, depth_from_pair,
-    depth_from_rectified, depth_from_selected, depth_from_views,
+    DepthParams, DepthResult, ForwardMotion, MatchMethod, SWEEP_EPIPOLE_MARGIN,
+    depth_by_plane_sweep, depth_from_pair, depth_from_rectified, depth_from_selected,
+    depth_from_views,
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
 pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry};

@@ -160,6 +160,9 @@ pub fn depth_from_pair(
     params: &DepthParams,
 ) -> Result<DepthResult> {
     let quality = extrinsic_quality(reference.world_from_camera(), other.world_from_camera())?;
+    if params.forward_motion == ForwardMotion::PlaneSweep && epipole_near_image(reference, other) {
+        return depth_by_plane_sweep(reference, other, quality.q, params);
+    }
     let rectification = match Rectification::new(
         reference.intrinsics(),
         reference.world_from_camera(),
@@ -176,6 +179,37 @@ pub fn depth_from_pair(
     let left = rectification.warp(Side::Reference, reference.image())?;
     let right = rectification.warp(Side::Other, other.image())?;
     depth_from_rectified(&left, &right, rectification.geometry(), quality.q, params)
+}
+
+/// How far outside an image (as a fraction of its width and height, on every side) an epipole
+/// still sends a pair to the plane sweep under [`ForwardMotion::PlaneSweep`].
+///
+/// Rectification turns both cameras to look across the baseline; with the epipole just outside
+/// the image (the vehicle flying nearly at what it looks at, pitching or turning) that warps the
+/// images so far that matching along rows finds confident false matches. In the closed-loop
+/// flights such pairs, with the epipole 77-96 px below a 240 px image, gave 1,800-3,200 pixels
+/// each at under 2 m where the true surface lay beyond 20 m (`docs/depth.md`).
+pub const SWEEP_EPIPOLE_MARGIN: f64 = 0.5;
+
+/// Whether either camera's epipole (the other camera's centre seen from it, in front or behind)
+/// lies within [`SWEEP_EPIPOLE_MARGIN`] of its image.
+fn epipole_near_image(reference: &Frame, other: &Frame) -> bool {
+    let (a, b) = (reference.world_from_camera(), other.world_from_camera());
+    [(reference, a, b), (other, b, a)]
+        .into_iter()
+        .any(|(frame, pose, seen)| {
+            let direction =
+                pose.inverse_transform_vector(&(seen.translation.vector - pose.translation.vector));
+            if direction.z.abs() <= 1e-12 * direction.norm() {
+                return false;
+            }
+            let k = frame.intrinsics();
+            let (w, h) = (f64::from(k.width()), f64::from(k.height()));
+            let u = k.fx() * direction.x / direction.z + k.cx();
+            let v = k.fy() * direction.y / direction.z + k.cy();
+            let (mx, my) = (SWEEP_EPIPOLE_MARGIN * w, SWEEP_EPIPOLE_MARGIN * h);
+            (-0.5 - mx..w - 0.5 + mx).contains(&u) && (-0.5 - my..h - 0.5 + my).contains(&v)
+        })
 }
 
 /// Depth from two posed frames by plane sweep in the original reference camera, whatever their
