@@ -154,6 +154,35 @@ fn looking_aside_at_take_off_sees_the_wall_that_forward_motion_misses() {
 }
 
 #[test]
+fn a_flight_that_comes_no_nearer_ends_as_stuck() {
+    // The goal lies inside a building: once the vehicle has mapped the face in front of it, no
+    // voxel nearer to the goal can be entered.
+    let scenario = one_box(
+        "goal inside",
+        Point3::new(6.0, 0.0, 3.0),
+        Vector3::new(1.5, 1.5, 3.0),
+    );
+    let goal = Goal {
+        start: Point3::new(0.0, 0.3, 2.1),
+        goal: Point3::new(6.0, 0.3, 2.1),
+        truth_length: 6.0,
+    };
+    let config = FlyConfig::default();
+    let mut map = FlyModel::Fuzzy.new_map(config.resolution).unwrap();
+    integrate_prior(&scenario, &mut map, &goal.start, &config).unwrap();
+    let log = fly_goal(&scenario, &goal, &mut map, &config, 2).unwrap();
+    assert_eq!(log.ending, Ending::Stuck, "{:?}", log.trajectory);
+    // It gave the vehicle `patience` seconds, and ended long before the time limit.
+    let frames = (config.patience / config.frame_interval) as usize;
+    assert!(log.frames >= frames, "{} frames", log.frames);
+    assert!(
+        (log.frames as f64) * config.frame_interval < config.time_limit / 2.0,
+        "{} frames",
+        log.frames
+    );
+}
+
+#[test]
 fn fly_reports_every_map_as_json() {
     let out = std::env::temp_dir().join(format!("fuzzyvox-fly-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
@@ -216,6 +245,10 @@ fn fly_reports_every_map_as_json() {
         (
             &["fly", "--scenario", "wall", "--guard=-1"][..],
             "unknown guard",
+        ),
+        (
+            &["fly", "--scenario", "wall", "--patience", "0"][..],
+            "patience",
         ),
     ] {
         let run = fuzzyvox(args);

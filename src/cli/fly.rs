@@ -66,6 +66,10 @@ pub struct FlyArgs {
     /// this distance of the vehicle are never entered [default: 0, off].
     #[arg(long, value_name = "M")]
     guard: Option<f64>,
+    /// A flight that comes no nearer to its goal for this many seconds ends as stuck
+    /// [default: 15].
+    #[arg(long, value_name = "S")]
+    patience: Option<f64>,
     /// Write fly.json and a top-down figure of each flight over its final map here.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -109,6 +113,7 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
         look_turn: args.look_turn.unwrap_or(defaults.look_turn),
         max_yaw_rate: args.yaw_rate.unwrap_or(defaults.max_yaw_rate),
         unknown_guard: args.guard.unwrap_or(defaults.unknown_guard),
+        patience: args.patience.unwrap_or(defaults.patience),
         ..defaults
     };
     config.planner.unknown = match (args.unknown, args.unknown_cost) {
@@ -169,12 +174,13 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
     for model in &flights {
         let s = model.summary(&goals);
         println!(
-            "  {:8} reached {:>3.0} %, collisions {}, no path {}, out of time {}; length / true path {}; \
+            "  {:8} reached {:>3.0} %, collisions {}, no path {}, stuck {}, out of time {}; length / true path {}; \
              per cycle: depth {:.0} ms, integration {:.0} ms, update and replan {:.1} ms (full rebuild {:.0} ms)",
             model.model.name(),
             s.reached * 100.0,
             s.collisions,
             s.no_path,
+            s.stuck,
             s.time_limit,
             s.length_ratio.map_or("n/a".into(), |r| format!("{r:.2}")),
             s.depth_ms,

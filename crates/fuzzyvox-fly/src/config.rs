@@ -17,6 +17,11 @@ pub struct FlyConfig {
     pub frame_interval: f64,
     /// A flight that has not reached its goal after this many seconds ends. Default: 60.
     pub time_limit: f64,
+    /// A flight that has come no nearer to its goal (by a voxel edge) for this many seconds
+    /// ends as stuck: a vehicle dithering in front of a goal its map will not let it enter
+    /// reports so instead of hovering until the time limit. Default 15 (a detour round a
+    /// building takes a few seconds of flying away from the goal).
+    pub patience: f64,
     /// Camera views per depth image (2: the current and the previous frame). Default 2.
     pub views: usize,
     /// Nearest depth the depth stage looks for, metres. A plane sweep's planes, and so its
@@ -90,6 +95,7 @@ impl Default for FlyConfig {
             speed: 2.0,
             frame_interval: 0.25,
             time_limit: 60.0,
+            patience: 15.0,
             views: 2,
             min_depth: 1.0,
             map_range: 20.0,
@@ -133,6 +139,7 @@ impl FlyConfig {
         positive("speed", self.speed)?;
         positive("frame interval", self.frame_interval)?;
         positive("time limit", self.time_limit)?;
+        positive("patience", self.patience)?;
         positive("prior radius", self.prior_radius)?;
         positive("look-ahead", self.look_ahead)?;
         positive("maximum yaw rate", self.max_yaw_rate)?;

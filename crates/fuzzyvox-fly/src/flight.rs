@@ -32,6 +32,8 @@ pub enum Ending {
     /// The map offered no path (not even towards the goal) for [`STALL_FRAMES`] frames in a
     /// row.
     NoPath,
+    /// The vehicle came no nearer to the goal for [`FlyConfig::patience`] seconds.
+    Stuck,
 }
 
 /// A flight has reached its goal within this many voxel edges of it (`√3`: in the goal's
@@ -180,6 +182,11 @@ pub struct Flight<'a> {
     looked_at: usize,
     frame_index: usize,
     max_frames: usize,
+    /// The nearest the vehicle has come to the goal, metres, and the frame it came there (by
+    /// at least a voxel edge nearer than before).
+    nearest: f64,
+    nearer_at: usize,
+    patience_frames: usize,
     ending: Option<Ending>,
     log: FlightLog,
 }
@@ -225,6 +232,9 @@ impl<'a> Flight<'a> {
             looked_at: 0,
             frame_index: 0,
             max_frames: (config.time_limit / config.frame_interval).ceil() as usize,
+            nearest: (goal.goal - goal.start).norm(),
+            nearer_at: 0,
+            patience_frames: (config.patience / config.frame_interval).ceil() as usize,
             ending: None,
             log: FlightLog {
                 ending: Ending::TimeLimit,
@@ -282,8 +292,11 @@ impl<'a> Flight<'a> {
             return Ok(());
         }
         if self.frame_index >= self.max_frames {
-            self.ending = Some(Ending::TimeLimit);
-            self.log.ending = Ending::TimeLimit;
+            self.finish(Ending::TimeLimit);
+            return Ok(());
+        }
+        if self.frame_index >= self.nearer_at + self.patience_frames {
+            self.finish(Ending::Stuck);
             return Ok(());
         }
         let frame = self.render()?;
@@ -471,8 +484,13 @@ impl<'a> Flight<'a> {
         self.position = next;
         self.log.trajectory.push(next);
         self.log.seconds = (self.frame_index + 1) as f64 * self.config.frame_interval;
-        let reach = REACHED_VOXELS * map.as_map().resolution().size();
-        if (next - self.goal.goal).norm() <= reach {
+        let edge = map.as_map().resolution().size();
+        let distance = (next - self.goal.goal).norm();
+        if distance <= self.nearest - edge {
+            self.nearest = distance;
+            self.nearer_at = self.frame_index + 1;
+        }
+        if distance <= REACHED_VOXELS * edge {
             self.finish(Ending::Reached);
         }
     }

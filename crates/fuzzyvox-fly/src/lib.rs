@@ -113,6 +113,8 @@ pub struct ModelSummary {
     pub time_limit: usize,
     /// Flights that gave up without a path.
     pub no_path: usize,
+    /// Flights that came no nearer to their goal for [`FlyConfig::patience`] seconds.
+    pub stuck: usize,
     /// Mean, over reached goals, of the length flown over the length of the true scene's path.
     pub length_ratio: Option<f64>,
     /// Mean time to goal over reached goals, seconds.
@@ -175,6 +177,7 @@ impl ModelFlights {
             collisions: count(Ending::Collided),
             time_limit: count(Ending::TimeLimit),
             no_path: count(Ending::NoPath),
+            stuck: count(Ending::Stuck),
             length_ratio: mean(
                 reached
                     .iter()

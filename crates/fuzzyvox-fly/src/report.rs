@@ -137,19 +137,20 @@ pub fn flights_markdown(
     );
     let _ = writeln!(
         out,
-        "| map | goals reached | collisions | no path | out of time | length / true path | \
+        "| map | goals reached | collisions | no path | stuck | out of time | length / true path | \
          depth ms | integration ms | update and replan ms | full rebuild ms |\n\
-         |---|---|---|---|---|---|---|---|---|---|"
+         |---|---|---|---|---|---|---|---|---|---|---|"
     );
     for model in flights {
         let s = model.summary(goals);
         let _ = writeln!(
             out,
-            "| {} | {:.2} | {} | {} | {} | {} | {:.0} | {:.0} | {:.1} | {:.0} |",
+            "| {} | {:.2} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.1} | {:.0} |",
             model.model.name(),
             s.reached,
             s.collisions,
             s.no_path,
+            s.stuck,
             s.time_limit,
             s.length_ratio.map_or("n/a".into(), |r| format!("{r:.2}")),
             s.depth_ms,
