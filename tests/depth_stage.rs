@@ -190,10 +190,7 @@ fn forward_motion_measures_pixels_near_the_epipole() {
             continue;
         }
         measured += 1;
-        let ray = reference_pose.rotation * k.back_project(u, v, 1.0).coords;
-        let truth = (reference_pose.inverse() * plane_hit(&Point3::origin(), &ray).unwrap()).z;
-        let (near, far) = (f64::from(image.near()[i]), f64::from(image.far()[i]));
-        inside += usize::from(near <= truth && (truth <= far || far.is_nan()));
+        inside += usize::from(interval_holds_truth(image, &reference_pose, i));
     }
     let share = measured as f64 / annulus as f64;
     assert!(
@@ -206,6 +203,21 @@ fn forward_motion_measures_pixels_near_the_epipole() {
         "truth inside the interval for {held:.3} near the epipole"
     );
     assert_eq!(at_epipole, 0, "the epipole itself has no depth");
+}
+
+/// Whether pixel `i` of a depth image in the camera at `pose` (at the origin) holds the
+/// textured plane's true depth in `[P-, P+]` (an undefined `P+` holds everything beyond `P-`).
+fn interval_holds_truth(
+    image: &fuzzyvox::IntervalDepthImage,
+    pose: &Isometry3<f64>,
+    i: usize,
+) -> bool {
+    let k = camera();
+    let (u, v) = ((i % 320) as f64, (i / 320) as f64);
+    let ray = pose.rotation * k.back_project(u, v, 1.0).coords;
+    let truth = (pose.inverse() * plane_hit(&Point3::origin(), &ray).unwrap()).z;
+    let (near, far) = (f64::from(image.near()[i]), f64::from(image.far()[i]));
+    near <= truth && (truth <= far || far.is_nan())
 }
 
 #[test]
@@ -235,11 +247,7 @@ fn a_pair_with_the_epipole_just_outside_the_image_is_swept() {
             continue;
         }
         measured += 1;
-        let (u, v) = ((i % 320) as f64, (i / 320) as f64);
-        let ray = reference_pose.rotation * k.back_project(u, v, 1.0).coords;
-        let truth = (reference_pose.inverse() * plane_hit(&Point3::origin(), &ray).unwrap()).z;
-        let (near, far) = (f64::from(image.near()[i]), f64::from(image.far()[i]));
-        inside += usize::from(near <= truth && (truth <= far || far.is_nan()));
+        inside += usize::from(interval_holds_truth(image, &reference_pose, i));
     }
     assert!(measured > 320 * 240 / 2, "{measured} pixels measured");
     let held = inside as f64 / measured as f64;

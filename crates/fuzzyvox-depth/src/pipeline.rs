@@ -9,7 +9,7 @@ use super::interval::{IntervalParams, interval_image};
 use super::matching::match_pair;
 use super::params::{DisparityMap, MatchParams};
 use super::quality::extrinsic_quality;
-use super::rectify::{Rectification, Side, StereoGeometry};
+use super::rectify::{Rectification, Side, StereoGeometry, epipole_within};
 use super::sweep::{Sweep, sweep_views};
 use crate::error::UnrectifiableReason;
 use crate::error::{Error, Result};
@@ -187,28 +187,23 @@ pub fn depth_from_pair(
 /// Rectification turns both cameras to look across the baseline; with the epipole just outside
 /// the image (the vehicle flying nearly at what it looks at, pitching or turning) that warps the
 /// images so far that matching along rows finds confident false matches. In the closed-loop
-/// flights such pairs, with the epipole 77-96 px below a 240 px image, gave 1,800-3,200 pixels
-/// each at under 2 m where the true surface lay beyond 20 m (`docs/depth.md`).
+/// flights two such pairs, with the epipole 77 and 96 px below a 240 px image, gave 2,750 and
+/// 1,870 pixels at under 2 m where the true surface lay beyond 20 m (`docs/depth.md`).
 pub const SWEEP_EPIPOLE_MARGIN: f64 = 0.5;
 
-/// Whether either camera's epipole (the other camera's centre seen from it, in front or behind)
-/// lies within [`SWEEP_EPIPOLE_MARGIN`] of its image.
+/// Whether either camera's epipole lies within [`SWEEP_EPIPOLE_MARGIN`] of its image.
 fn epipole_near_image(reference: &Frame, other: &Frame) -> bool {
     let (a, b) = (reference.world_from_camera(), other.world_from_camera());
     [(reference, a, b), (other, b, a)]
         .into_iter()
         .any(|(frame, pose, seen)| {
-            let direction =
-                pose.inverse_transform_vector(&(seen.translation.vector - pose.translation.vector));
-            if direction.z.abs() <= 1e-12 * direction.norm() {
-                return false;
-            }
-            let k = frame.intrinsics();
-            let (w, h) = (f64::from(k.width()), f64::from(k.height()));
-            let u = k.fx() * direction.x / direction.z + k.cx();
-            let v = k.fy() * direction.y / direction.z + k.cy();
-            let (mx, my) = (SWEEP_EPIPOLE_MARGIN * w, SWEEP_EPIPOLE_MARGIN * h);
-            (-0.5 - mx..w - 0.5 + mx).contains(&u) && (-0.5 - my..h - 0.5 + my).contains(&v)
+            epipole_within(
+                frame.intrinsics(),
+                pose,
+                &seen.translation.vector,
+                SWEEP_EPIPOLE_MARGIN,
+            )
+            .is_some()
         })
 }
 

@@ -157,18 +157,12 @@ impl Rectification {
             ("reference", reference, world_from_reference, c_other),
             ("other", other, world_from_other, c_ref),
         ] {
-            let direction = pose.rotation.inverse() * (seen - pose.translation.vector);
-            if direction.z.abs() > 1e-12 * direction.norm() {
-                let u = k.fx() * direction.x / direction.z + k.cx();
-                let v = k.fy() * direction.y / direction.z + k.cy();
-                let (w, h) = (f64::from(k.width()), f64::from(k.height()));
-                if (-0.5..w - 0.5).contains(&u) && (-0.5..h - 0.5).contains(&v) {
-                    return Err(unrectifiable(UnrectifiableReason::EpipoleInImage {
-                        camera,
-                        u,
-                        v,
-                    }));
-                }
+            if let Some((u, v)) = epipole_within(k, pose, &seen, 0.0) {
+                return Err(unrectifiable(UnrectifiableReason::EpipoleInImage {
+                    camera,
+                    u,
+                    v,
+                }));
             }
         }
         // FTV: new x along the baseline, new y orthogonal to x and the (mean) old optical axis,
@@ -276,6 +270,28 @@ impl Rectification {
             });
         GrayImage::new(width, height, pixels)
     }
+}
+
+/// The epipole `(u, v)` of the camera `k` at `pose` (the point `seen`, another camera's centre,
+/// projected through it, in front or behind) when it lies inside the image grown by `margin`
+/// times its width and height on every side; `None` otherwise, or when the centre lies in the
+/// image plane's direction (epipole at infinity).
+pub(crate) fn epipole_within(
+    k: &PinholeIntrinsics,
+    pose: &Isometry3<f64>,
+    seen: &Vector3<f64>,
+    margin: f64,
+) -> Option<(f64, f64)> {
+    let direction = pose.rotation.inverse() * (seen - pose.translation.vector);
+    if direction.z.abs() <= 1e-12 * direction.norm() {
+        return None;
+    }
+    let u = k.fx() * direction.x / direction.z + k.cx();
+    let v = k.fy() * direction.y / direction.z + k.cy();
+    let (w, h) = (f64::from(k.width()), f64::from(k.height()));
+    let (mx, my) = (margin * w, margin * h);
+    ((-0.5 - mx..w - 0.5 + mx).contains(&u) && (-0.5 - my..h - 0.5 + my).contains(&v))
+        .then_some((u, v))
 }
 
 fn matrix_of(k: &PinholeIntrinsics) -> Matrix3<f64> {
