@@ -250,6 +250,14 @@ fn fly_reports_every_map_as_json() {
             &["fly", "--scenario", "wall", "--patience", "0"][..],
             "patience",
         ),
+        (
+            &["fly", "--scenario", "wall", "--leaning", "0"][..],
+            "leaning occupied",
+        ),
+        (
+            &["fly", "--scenario", "wall", "--leaning", "NaN"][..],
+            "leaning occupied",
+        ),
     ] {
         let run = fuzzyvox(args);
         assert!(!run.status.success(), "{args:?}");

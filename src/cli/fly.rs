@@ -66,6 +66,11 @@ pub struct FlyArgs {
     /// this distance of the vehicle are never entered [default: 0, off].
     #[arg(long, value_name = "M")]
     guard: Option<f64>,
+    /// Unknown voxels within the look-ahead whose occupied membership reaches this (and exceeds
+    /// their free membership) are never entered: surfaces seen, though not confidently
+    /// [default: 0.3; above 1 turns it off].
+    #[arg(long, value_name = "MEMBERSHIP")]
+    leaning: Option<f64>,
     /// A flight that comes no nearer to its goal for this many seconds ends as stuck
     /// [default: 15].
     #[arg(long, value_name = "S")]
@@ -113,6 +118,7 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
         look_turn: args.look_turn.unwrap_or(defaults.look_turn),
         max_yaw_rate: args.yaw_rate.unwrap_or(defaults.max_yaw_rate),
         unknown_guard: args.guard.unwrap_or(defaults.unknown_guard),
+        leaning_occupied: args.leaning.unwrap_or(defaults.leaning_occupied),
         patience: args.patience.unwrap_or(defaults.patience),
         ..defaults
     };

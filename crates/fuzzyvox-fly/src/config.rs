@@ -76,6 +76,12 @@ pub struct FlyConfig {
     /// The guard forbids only unknown voxels within this distance of an occupied or ambiguous
     /// voxel, metres: the unseen parts of surfaces the map has begun to see. Default 0.6.
     pub guard_surface_reach: f64,
+    /// Within [`FlyConfig::look_ahead`] of the vehicle, unknown voxels whose occupied
+    /// membership is at least this (and above their free membership) are forbidden, with every
+    /// voxel within the vehicle's radius of them, whatever the guard's radius: the map has seen
+    /// a surface there, though not confidently enough to call it occupied (see
+    /// [`UnknownGuard`](super::guard::UnknownGuard)). Above 1 turns it off. Default 0.3.
+    pub leaning_occupied: f64,
     /// Horizontal margin of the planning region around start and goal, metres. Default 6.
     pub region_margin: f64,
     /// Lowest and highest altitude of starts and goals, metres. Default 1.5 to 6.
@@ -113,6 +119,7 @@ impl Default for FlyConfig {
             replan_every: 8,
             unknown_guard: 0.0,
             guard_surface_reach: 0.6,
+            leaning_occupied: 0.3,
             region_margin: 6.0,
             altitude: (1.5, 6.0),
             distance: (8.0, 20.0),
@@ -158,6 +165,13 @@ impl FlyConfig {
                     expected: "a finite distance >= 0 m",
                 });
             }
+        }
+        if !(self.leaning_occupied.is_finite() && self.leaning_occupied > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "leaning occupied",
+                value: self.leaning_occupied,
+                expected: "a finite membership > 0 (above 1 turns it off)",
+            });
         }
         for (name, value) in [
             ("maximum pitch", self.max_pitch),

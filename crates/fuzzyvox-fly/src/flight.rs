@@ -392,6 +392,13 @@ impl<'a> Flight<'a> {
         self.planner.update(map.as_map());
         let updated = ms(t);
         let t = Instant::now();
+        self.guard.add_leaning(
+            map.as_map(),
+            self.planner.field(),
+            &self.position,
+            self.config.look_ahead,
+            self.config.leaning_occupied as f32,
+        );
         self.guard.update(
             self.planner.field(),
             &self.position,

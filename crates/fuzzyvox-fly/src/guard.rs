@@ -11,10 +11,21 @@
 //! ambiguous voxel ("suspect" voxels), and every voxel within the vehicle's radius of one.
 //! Suspects are remembered until the map learns what they are, so that the forbidden set does
 //! not move with the vehicle (a set that moves makes paths flip from one frame to the next).
+//!
+//! The guard also takes as suspects, within [`FlyConfig::look_ahead`](super::FlyConfig::look_ahead)
+//! of the vehicle, the unknown voxels that **lean occupied**
+//! ([`UnknownGuard::add_leaning`]): occupied membership at least
+//! [`FlyConfig::leaning_occupied`](super::FlyConfig::leaning_occupied) and above the free one.
+//! A fuzzy map holds a surface seen only by motion along the view (a pair's `Q_ABD` caps its
+//! confidence) or only once at such a membership, below the occupied class: the map has seen
+//! something there, not nothing, and flying into it at the unknown-space cost is how a vehicle
+//! hits what it saw badly. Only graded maps have such voxels (a log-odds voxel that leans
+//! occupied is occupied).
 
 use nalgebra::Point3;
 use rustc_hash::FxHashSet;
 
+use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
 use crate::plan::CostField;
 
@@ -88,6 +99,54 @@ impl UnknownGuard {
                                 self.marked.push(i);
                             }
                         }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds as suspects the unknown voxels of `field` within `radius` metres of `position`
+    /// whose memberships in `map` lean occupied: occupied membership at least `threshold` and
+    /// above the free membership. A threshold above 1 (or a radius of 0) adds nothing. Call
+    /// before [`UnknownGuard::update`], which turns suspects into forbidden voxels.
+    pub fn add_leaning(
+        &mut self,
+        map: &dyn VoxelMap,
+        field: &CostField,
+        position: &Point3<f64>,
+        radius: f64,
+        threshold: f32,
+    ) {
+        if radius <= 0.0 || threshold.is_nan() || threshold > 1.0 {
+            return;
+        }
+        let region = *field.region();
+        let dims = region.dims();
+        let resolution = field.resolution();
+        let Some(here) = resolution
+            .key_of(position)
+            .ok()
+            .and_then(|key| region.index_of(key))
+        else {
+            return;
+        };
+        let centre = region.coordinates_at(here);
+        let r = (radius / resolution.size()).ceil() as i64;
+        let ball = (radius / resolution.size()).powi(2) + 1e-9;
+        for z in (centre[2] - r).max(0)..=(centre[2] + r).min(dims[2] as i64 - 1) {
+            for y in (centre[1] - r).max(0)..=(centre[1] + r).min(dims[1] as i64 - 1) {
+                for x in (centre[0] - r).max(0)..=(centre[0] + r).min(dims[0] as i64 - 1) {
+                    let c = [x, y, z];
+                    if squared(c, centre) > ball {
+                        continue;
+                    }
+                    let i = region.index_at(c);
+                    if field.class(i) != VoxelClass::Unknown || self.suspects.contains(&i) {
+                        continue;
+                    }
+                    let m = map.memberships_at(region.key_at(i));
+                    if m.occupied >= threshold && m.occupied > m.free {
+                        self.suspects.insert(i);
                     }
                 }
             }
@@ -215,5 +274,64 @@ mod tests {
         off.update(&field, &centre(12, 15, 5), 0.0, 0.6);
         assert_eq!(off.suspects(), 0);
         assert!(!UnknownGuard::new().forbids(index(15, 16, 5)));
+    }
+
+    #[test]
+    fn unknown_that_leans_occupied_is_forbidden() {
+        let resolution = Resolution::new(0.2).unwrap();
+        // Free space with one voxel seen as a surface below the occupied class (0.43), one
+        // with a trace of occupied evidence (0.1) and one that leans free.
+        let map = FunctionMap::new(resolution, |key| match (key.x, key.y, key.z) {
+            (10, 10, 5) => Memberships {
+                occupied: 0.43,
+                free: 0.0,
+            },
+            (10, 20, 5) => Memberships {
+                occupied: 0.1,
+                free: 0.0,
+            },
+            (20, 10, 5) => Memberships {
+                occupied: 0.35,
+                free: 0.4,
+            },
+            _ => Memberships {
+                occupied: 0.0,
+                free: 0.95,
+            },
+        });
+        let region = PlanningRegion::new(VoxelKey::new(0, 0, 0), VoxelKey::new(29, 29, 9)).unwrap();
+        let config = PlannerConfig {
+            unknown: UnknownPolicy::Cost(2.0),
+            ..PlannerConfig::default()
+        };
+        let field = CostField::build(&map, region, config).unwrap();
+        let index = |x, y, z| region.index_of(VoxelKey::new(x, y, z)).unwrap();
+        assert!(
+            !field.is_blocked(index(10, 10, 5)),
+            "unknown, crossed at a cost"
+        );
+        let at = resolution.center(VoxelKey::new(15, 15, 5));
+        let mut guard = UnknownGuard::new();
+        guard.add_leaning(&map, &field, &at, 3.0, 0.3);
+        guard.update(&field, &at, 0.0, 0.6);
+        assert_eq!(guard.suspects(), 1);
+        assert!(guard.forbids(index(10, 10, 5)));
+        // And every voxel within the vehicle's radius of it.
+        assert!(guard.forbids(index(11, 10, 5)));
+        assert!(!guard.forbids(index(12, 10, 5)));
+        assert!(!guard.forbids(index(10, 20, 5)));
+        assert!(!guard.forbids(index(20, 10, 5)));
+        // Out of reach, or off (a threshold above 1), nothing is added.
+        let mut far = UnknownGuard::new();
+        far.add_leaning(
+            &map,
+            &field,
+            &resolution.center(VoxelKey::new(25, 25, 5)),
+            2.0,
+            0.3,
+        );
+        let mut off = UnknownGuard::new();
+        off.add_leaning(&map, &field, &at, 3.0, 1.5);
+        assert_eq!((far.suspects(), off.suspects()), (0, 0));
     }
 }
