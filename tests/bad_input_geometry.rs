@@ -565,6 +565,20 @@ fn matching_parameters_out_of_range_are_errors() {
                 ..defaults.clone()
             },
         ),
+        (
+            "NaN contrast",
+            MatchParams {
+                min_contrast: f32::NAN,
+                ..defaults.clone()
+            },
+        ),
+        (
+            "negative contrast",
+            MatchParams {
+                min_contrast: -0.01,
+                ..defaults.clone()
+            },
+        ),
     ] {
         assert!(
             matches!(

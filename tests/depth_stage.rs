@@ -661,3 +661,69 @@ fn damaged_pfm_files_are_typed_errors() {
     ));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A camera 2 m above textured ground, looking level: the lower half of its image is ground, the
+/// upper half a clear sky. A sideways pair measures the ground and, with the texture test, none
+/// of the sky beyond the windows that reach the horizon; without it, the matcher puts sky
+/// pixels at confident false depths.
+#[test]
+fn a_clear_sky_gives_no_depth() {
+    use fuzzyvox::sim::{Scene, render, trajectory::look_at};
+    let mut scene = Scene::new();
+    scene.add_ground(0.0, 400.0);
+    let k = PinholeIntrinsics::new(320, 240, 277.0, 277.0, 159.5, 119.5).unwrap();
+    let frame = |y: f64, seed: u64| {
+        let pose = look_at(Point3::new(0.0, y, 2.0), Vector3::new(1.0, 0.0, 0.0));
+        render(&scene, &k, &pose, seed, 240.0).to_frame(k, pose, y)
+    };
+    let (reference, other) = (frame(0.0, 40).unwrap(), frame(-0.5, 41).unwrap());
+    let sky = |params: &DepthParams| {
+        let result = depth_from_pair(&reference, &other, params).unwrap();
+        let image = result.frame.image();
+        let pose = result.frame.world_from_camera();
+        let intrinsics = result.frame.intrinsics();
+        let (mut sky, mut confident_sky, mut ground) = (0, 0, 0);
+        for v in 0..image.height() {
+            for u in 0..image.width() {
+                let i = (v * image.width() + u) as usize;
+                if !image.depth()[i].is_finite() {
+                    continue;
+                }
+                let ray = pose.rotation * intrinsics.back_project(f64::from(u), f64::from(v), 1.0);
+                let elevation = ray.coords.z.atan2(ray.coords.x.hypot(ray.coords.y));
+                if elevation < 0.0 {
+                    ground += 1;
+                } else if elevation > 2f64.to_radians() {
+                    // Sky further from the horizon than a matching window reaches.
+                    sky += 1;
+                    confident_sky += usize::from(image.confidence()[i] > 0.2);
+                }
+            }
+        }
+        (sky, confident_sky, ground)
+    };
+    let range = Some((1.0, 60.0));
+    let with = DepthParams {
+        depth_range: range,
+        ..DepthParams::default()
+    };
+    let mut without = with.clone();
+    without.matching.min_contrast = 0.0;
+    let (sky_off, confident_off, ground_off) = sky(&without);
+    let (sky_on, confident_on, ground_on) = sky(&with);
+    // The premise: without the test, the sky is "measured", some of it confidently.
+    assert!(
+        sky_off > 100 && confident_off > 0,
+        "{sky_off} {confident_off}"
+    );
+    assert_eq!(
+        (sky_on, confident_on),
+        (0, 0),
+        "the sky, with the texture test"
+    );
+    // The ground keeps its depth.
+    assert!(
+        ground_on > 10_000 && ground_on * 10 > ground_off * 9,
+        "{ground_on} {ground_off}"
+    );
+}

@@ -33,6 +33,7 @@ struct Input {
     uniqueness_ratio: u8,
     left_right_tolerance: Option<u8>,
     range_tolerance: f32,
+    min_contrast: f32,
     fixed_delta: bool,
     /// Match forward-motion pairs by plane sweep instead of refusing them.
     plane_sweep: bool,
@@ -90,6 +91,7 @@ fuzz_target!(|input: Input| {
             uniqueness_ratio: u32::from(input.uniqueness_ratio),
             left_right_tolerance: input.left_right_tolerance.map(u32::from),
             range_tolerance: input.range_tolerance,
+            min_contrast: input.min_contrast,
         },
         interval: IntervalParams {
             method: if input.fixed_delta {

@@ -68,9 +68,13 @@ pub struct FlyArgs {
     guard: Option<f64>,
     /// Unknown voxels within the look-ahead whose occupied membership reaches this (and exceeds
     /// their free membership) are never entered: surfaces seen, though not confidently
-    /// [default: 0.3; above 1 turns it off].
+    /// [default: 0.2; above 1 turns it off].
     #[arg(long, value_name = "MEMBERSHIP")]
     leaning: Option<f64>,
+    /// Let steps into unknown space leave the camera's last picture (by default the vehicle
+    /// enters unknown space only where its camera has just looked).
+    #[arg(long)]
+    blind_steps: bool,
     /// A flight that comes no nearer to its goal for this many seconds ends as stuck
     /// [default: 15].
     #[arg(long, value_name = "S")]
@@ -119,6 +123,7 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
         max_yaw_rate: args.yaw_rate.unwrap_or(defaults.max_yaw_rate),
         unknown_guard: args.guard.unwrap_or(defaults.unknown_guard),
         leaning_occupied: args.leaning.unwrap_or(defaults.leaning_occupied),
+        blind_steps: args.blind_steps,
         patience: args.patience.unwrap_or(defaults.patience),
         ..defaults
     };

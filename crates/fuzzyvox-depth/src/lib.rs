@@ -35,6 +35,7 @@ mod rectify;
 mod scan;
 mod stream;
 mod sweep;
+mod texture;
 mod views;
 
 pub use crate::error::UnrectifiableReason;
@@ -49,7 +50,7 @@ pub use interval::{
 };
 pub use matching::match_pair;
 pub use metrics::{Accuracy, evaluate};
-pub use params::{DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
+pub use params::{DEFAULT_MIN_CONTRAST, DisparityMap, MAX_DISPARITIES, MAX_WINDOW, MatchParams};
 pub use pipeline::{
     DepthParams, DepthResult, ForwardMotion, MatchMethod, SWEEP_EPIPOLE_MARGIN,
     depth_by_plane_sweep, depth_from_pair, depth_from_rectified, depth_from_selected,
@@ -59,4 +60,5 @@ pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
 pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry};
 pub use stream::{DepthStream, SkipReason, StreamCounts};
 pub use sweep::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
+pub use texture::textureless;
 pub use views::ViewWindow;

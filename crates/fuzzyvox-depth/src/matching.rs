@@ -21,6 +21,7 @@ use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
 use super::gray::GrayImage;
 use super::params::{DisparityMap, MatchParams};
 use super::scan::{min_lane, scan_column};
+use super::texture::drop_textureless;
 use crate::error::{Error, Result};
 
 /// Disparities per step of the cost loop: sixteen `u8` lanes, one SSE register.
@@ -52,7 +53,8 @@ struct Context<'a> {
     keep: Vec<u8>,
 }
 
-/// Matches a rectified pair: `left(y, x)` corresponds to `right(y, x - d)`.
+/// Matches a rectified pair: `left(y, x)` corresponds to `right(y, x - d)`. Pixels of
+/// texture-less windows of `left` are not matched ([`MatchParams::min_contrast`]).
 ///
 /// Errors: images of different sizes, empty images, invalid parameters.
 pub fn match_pair(
@@ -70,7 +72,9 @@ pub fn match_pair(
     }
     let left_census = census_transform(left);
     let right_census = census_transform(right);
-    Ok(match_census(&left_census, &right_census, params))
+    let mut map = match_census(&left_census, &right_census, params);
+    drop_textureless(left, params, &mut map);
+    Ok(map)
 }
 
 /// Matches two census images of equal size (checked by [`match_pair`]).
@@ -856,6 +860,7 @@ mod tests {
                         uniqueness_ratio,
                         left_right_tolerance,
                         range_tolerance,
+                        min_contrast: 0.0,
                     };
                     let (lc, rc) = (census_transform(&left), census_transform(&right));
                     let fast = match_census(&lc, &rc, &params);

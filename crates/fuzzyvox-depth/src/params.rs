@@ -7,6 +7,12 @@ pub const MAX_WINDOW: u32 = 15;
 /// Largest supported number of disparities.
 pub const MAX_DISPARITIES: u32 = 1024;
 
+/// The default [`MatchParams::min_contrast`]: 0.5 %. The simulator's sky has a window contrast
+/// of 0.1-0.3 % (a brightness gradient and sensor noise), its textured surfaces 1.2 % and up
+/// (5th percentile of the matched pixels in the closed-loop flights); an 8-bit image region
+/// whose spread is under 0.6 grey levels at mid-grey is below it.
+pub const DEFAULT_MIN_CONTRAST: f32 = 0.004;
+
 /// Matching parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MatchParams {
@@ -28,6 +34,11 @@ pub struct MatchParams {
     /// Relative tolerance of the cost-curve range: every disparity whose aggregated cost is at
     /// most `best · (1 + tolerance)` lies in the range.
     pub range_tolerance: f32,
+    /// Texture test: a pixel whose aggregation window's contrast (standard deviation over the
+    /// mean) is below this is not matched: a clear sky or a blank patch matches every
+    /// disparity alike, and census finds confident false minima in its smooth gradients (see
+    /// `texture.rs`). Scale-free, so 0-1 and 0-255 images behave alike; 0 disables the test.
+    pub min_contrast: f32,
 }
 
 impl Default for MatchParams {
@@ -40,6 +51,7 @@ impl Default for MatchParams {
             uniqueness_ratio: 10,
             left_right_tolerance: Some(1),
             range_tolerance: 0.25,
+            min_contrast: DEFAULT_MIN_CONTRAST,
         }
     }
 }
@@ -71,6 +83,13 @@ impl MatchParams {
                 name: "uniqueness_ratio",
                 value: f64::from(self.uniqueness_ratio),
                 expected: "a percentage below 100",
+            });
+        }
+        if !(self.min_contrast.is_finite() && self.min_contrast >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "min_contrast",
+                value: f64::from(self.min_contrast),
+                expected: "a finite contrast >= 0",
             });
         }
         if !(self.range_tolerance.is_finite() && self.range_tolerance >= 0.0) {

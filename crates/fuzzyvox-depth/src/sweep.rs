@@ -39,6 +39,7 @@ use super::census::{CENSUS_BITS, CENSUS_MAX_COST, CensusImage, census_transform}
 use super::frame::Frame;
 use super::params::{DisparityMap, MAX_DISPARITIES, MatchParams};
 use super::rectify::{MIN_BASELINE, StereoGeometry};
+use super::texture::drop_textureless;
 use crate::error::UnrectifiableReason;
 use crate::error::{Error, Result};
 
@@ -688,7 +689,8 @@ fn sweep_band(
 
 /// Matches `reference` against the sweep's other views (`others`, in the order the sweep was
 /// made with) by plane sweep in the reference camera; the result's "disparity" is the
-/// fractional plane index.
+/// fractional plane index. Pixels of texture-less windows of the reference are not matched
+/// ([`MatchParams::min_contrast`]).
 pub(crate) fn sweep_views(
     reference: &Frame,
     others: &[&Frame],
@@ -757,6 +759,7 @@ pub(crate) fn sweep_views(
         map.range_high[i] = s.high as f32;
         map.cost[i] = f32::from(s.best) / max_cost as f32;
     }
+    drop_textureless(reference.image(), params, &mut map);
     Ok(map)
 }
 

@@ -80,8 +80,15 @@ pub struct FlyConfig {
     /// membership is at least this (and above their free membership) are forbidden, with every
     /// voxel within the vehicle's radius of them, whatever the guard's radius: the map has seen
     /// a surface there, though not confidently enough to call it occupied (see
-    /// [`UnknownGuard`](super::guard::UnknownGuard)). Above 1 turns it off. Default 0.3.
+    /// [`UnknownGuard`](super::guard::UnknownGuard)). Above 1 turns it off. Default 0.2.
     pub leaning_occupied: f64,
+    /// Steps into unknown space may head outside the camera's last picture. By default
+    /// (`false`) a step that would enter an unknown voxel must head at least
+    /// [`VIEW_MARGIN`](super::flight::VIEW_MARGIN) inside the picture's edges; otherwise it
+    /// turns towards the camera's axis, or the vehicle waits a frame for the camera to turn:
+    /// unknown space is crossed only where the camera has just looked. `true` keeps the
+    /// earlier behaviour, for comparison. Default false.
+    pub blind_steps: bool,
     /// Horizontal margin of the planning region around start and goal, metres. Default 6.
     pub region_margin: f64,
     /// Lowest and highest altitude of starts and goals, metres. Default 1.5 to 6.
@@ -119,7 +126,8 @@ impl Default for FlyConfig {
             replan_every: 8,
             unknown_guard: 0.0,
             guard_surface_reach: 0.6,
-            leaning_occupied: 0.3,
+            leaning_occupied: 0.2,
+            blind_steps: false,
             region_margin: 6.0,
             altitude: (1.5, 6.0),
             distance: (8.0, 20.0),

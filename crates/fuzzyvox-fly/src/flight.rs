@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use serde::Serialize;
 
 use super::config::FlyConfig;
@@ -13,6 +13,7 @@ use crate::depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
 use crate::error::Result;
 use crate::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
 use crate::map::AnyMap;
+use crate::measures::VoxelClass;
 use crate::plan::{CostField, PlanError, Planner, plan_in_field_avoiding};
 use crate::sim::render;
 use crate::sim::scenario::Scenario;
@@ -47,6 +48,11 @@ pub const LOOK_FRAMES: usize = 4;
 
 /// Frames in a row without a path after which a flight gives up.
 pub const STALL_FRAMES: usize = 12;
+
+/// How far inside the last picture's edges (a fraction of its width and height) a step into
+/// unknown space must head: the vehicle enters unknown space only where its camera has just
+/// looked.
+pub const VIEW_MARGIN: f64 = 0.1;
 
 /// Milliseconds each part of one cycle took.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -173,6 +179,8 @@ pub struct Flight<'a> {
     position: Point3<f64>,
     heading: Vector3<f64>,
     pitch: f64,
+    /// The camera's pose at the last picture: what the vehicle has just seen.
+    camera: Option<Isometry3<f64>>,
     since_plan: usize,
     stalled: usize,
     /// The camera's heading when the vehicle last side-stepped to look ahead (`None` before
@@ -180,6 +188,9 @@ pub struct Flight<'a> {
     looked: Option<Vector3<f64>>,
     /// The frame of the last look aside.
     looked_at: usize,
+    /// A step the vehicle held back because it headed outside the last picture: the next
+    /// picture looks along it.
+    aim: Option<Point3<f64>>,
     frame_index: usize,
     max_frames: usize,
     /// The nearest the vehicle has come to the goal, metres, and the frame it came there (by
@@ -226,10 +237,12 @@ impl<'a> Flight<'a> {
             position: goal.start,
             heading: level(goal.goal - goal.start).unwrap_or_else(Vector3::x),
             pitch: 0.0,
+            camera: None,
             since_plan: 0,
             stalled: 0,
             looked: None,
             looked_at: 0,
+            aim: None,
             frame_index: 0,
             max_frames: (config.time_limit / config.frame_interval).ceil() as usize,
             nearest: (goal.goal - goal.start).norm(),
@@ -318,17 +331,18 @@ impl<'a> Flight<'a> {
         Ok(())
     }
 
-    /// The picture the camera takes now: towards the point ahead on the path (turning at
+    /// The picture the camera takes now: towards the point ahead on the path, or along the
+    /// step the vehicle held back last frame because it headed outside the picture (turning at
     /// most [`FlyConfig::max_yaw_rate`], and pitching up or down as the path climbs or
     /// descends, up to [`FlyConfig::max_pitch`]), rendered from the true scene with the frame's
     /// noise.
     pub fn render(&mut self) -> Result<Frame> {
         let turn = self.config.max_yaw_rate.to_radians() * self.config.frame_interval;
-        if let Some(ahead) = self
-            .path
-            .as_deref()
-            .map(|p| point_ahead(p, self.config.look_ahead))
-        {
+        if let Some(ahead) = self.aim.take().or_else(|| {
+            self.path
+                .as_deref()
+                .map(|p| point_ahead(p, self.config.look_ahead))
+        }) {
             let to = ahead - self.position;
             if let Some(direction) = level(to) {
                 self.heading = turn_towards(self.heading, direction, turn);
@@ -345,6 +359,7 @@ impl<'a> Flight<'a> {
         }
         let (sin, cos) = self.pitch.sin_cos();
         let pose = look_at(self.position, self.heading * cos + Vector3::z() * sin);
+        self.camera = Some(pose);
         let noise = self
             .seed
             .wrapping_mul(1_000_003)
@@ -443,16 +458,30 @@ impl<'a> Flight<'a> {
         } else {
             None
         };
-        let next = match self.path.as_mut() {
-            Some(current) if !current.is_empty() => {
+        let next = match self.path.clone() {
+            Some(mut ahead) if !ahead.is_empty() => {
                 self.stalled = 0;
-                match look.or(weave) {
-                    Some(next) => {
-                        current[0] = next;
-                        next
+                let along = advance(&mut ahead, step);
+                let next = match look.or(weave) {
+                    Some(next) => next,
+                    None if self.sees(along) => {
+                        self.path = Some(ahead);
+                        along
                     }
-                    None => advance(current, step),
+                    // The path heads into unknown space the camera has not seen: turn the step
+                    // towards the view, or hold and look along the step in the next picture.
+                    None => match self.toward_view(along) {
+                        Some(next) => next,
+                        None => {
+                            self.aim = Some(along);
+                            return;
+                        }
+                    },
+                };
+                if let Some(current) = self.path.as_mut() {
+                    current[0] = next;
                 }
+                next
             }
             _ => {
                 // No path: look at the goal and side-step left and right (when the map and
@@ -472,6 +501,7 @@ impl<'a> Flight<'a> {
                 if !self
                     .planner
                     .is_clear_avoiding(&[position, next], &|i| self.guard.forbids(i))
+                    || !self.sees(next)
                 {
                     return;
                 }
@@ -524,11 +554,13 @@ impl<'a> Flight<'a> {
         let axis = nalgebra::Unit::new_normalize(Vector3::z());
         let turned = nalgebra::Rotation3::from_axis_angle(&axis, side * angle) * direction;
         let next = self.position + turned * step;
-        self.planner
+        (self
+            .planner
             .is_clear_avoiding(&[self.position, next, next_waypoint], &|i| {
                 self.guard.forbids(i)
             })
-            .then_some(next)
+            && self.sees(next))
+        .then_some(next)
     }
 
     /// The look-aside step: at take-off, and whenever the camera has turned by more than
@@ -555,6 +587,7 @@ impl<'a> Flight<'a> {
         let clear = |next: Point3<f64>| {
             self.planner
                 .is_clear_avoiding(&[self.position, next], &|i| self.guard.forbids(i))
+                && self.sees(next)
         };
         let next = [self.position + aside, self.position - aside]
             .into_iter()
@@ -562,6 +595,71 @@ impl<'a> Flight<'a> {
         self.looked = Some(self.heading);
         self.looked_at = self.frame_index;
         Some(next)
+    }
+
+    /// Whether the straight step from the vehicle to `next` keeps out of unknown voxels, or
+    /// heads into the picture the camera has just taken ([`VIEW_MARGIN`] inside its edges);
+    /// always with [`FlyConfig::blind_steps`].
+    /// Unknown space is crossed at a cost, but only where the camera looks: a path that
+    /// descends more steeply than the camera pitches (or a step to the side) otherwise flies
+    /// the vehicle into space no frame has shown it, such as the inside of a tree crown whose
+    /// top it saw from above.
+    fn sees(&self, next: Point3<f64>) -> bool {
+        self.config.blind_steps || !self.enters_unknown(next) || self.in_view(next)
+    }
+
+    /// Whether the direction from the vehicle to `next` lies inside the last picture, at least
+    /// [`VIEW_MARGIN`] of its width and height from its edges.
+    fn in_view(&self, next: Point3<f64>) -> bool {
+        let Some(camera) = self.camera else {
+            return false;
+        };
+        let k = &self.scenario.intrinsics;
+        let direction = camera.rotation.inverse() * (next - self.position);
+        let Some(pixel) = k.project(&Point3::from(direction)) else {
+            return false;
+        };
+        let (w, h) = (f64::from(k.width()), f64::from(k.height()));
+        let (mx, my) = (VIEW_MARGIN * w, VIEW_MARGIN * h);
+        (mx..=w - mx).contains(&pixel.x) && (my..=h - my).contains(&pixel.y)
+    }
+
+    /// Whether the straight step from the vehicle to `next` passes through an unknown voxel of
+    /// the field (or leaves the planning region), sampled every half voxel beyond the
+    /// vehicle's own position.
+    fn enters_unknown(&self, next: Point3<f64>) -> bool {
+        let field = self.planner.field();
+        let resolution = field.resolution();
+        let region = field.region();
+        let step = next - self.position;
+        let samples = (step.norm() / (0.5 * resolution.size())).ceil().max(1.0) as usize;
+        (1..=samples).any(|i| {
+            let p = self.position + step * (i as f64 / samples as f64);
+            resolution
+                .key_of(&p)
+                .ok()
+                .and_then(|key| region.index_of(key))
+                .is_none_or(|index| field.class(index) == VoxelClass::Unknown)
+        })
+    }
+
+    /// A step as long as the one to `along`, turned towards the camera's axis (a quarter,
+    /// half, three quarters or all the way) until [`Flight::sees`] accepts it and the field
+    /// and the guard hold it clear; `None` when no turn does.
+    fn toward_view(&self, along: Point3<f64>) -> Option<Point3<f64>> {
+        let axis = self.camera?.rotation * Vector3::z();
+        let step = along - self.position;
+        let (direction, length) = (step.try_normalize(1e-9)?, step.norm());
+        [0.25, 0.5, 0.75, 1.0]
+            .into_iter()
+            .filter_map(|t| (direction * (1.0 - t) + axis * t).try_normalize(1e-9))
+            .map(|turned| self.position + turned * length)
+            .find(|&next| {
+                self.sees(next)
+                    && self
+                        .planner
+                        .is_clear_avoiding(&[self.position, next], &|i| self.guard.forbids(i))
+            })
     }
 
     fn finish(&mut self, ending: Ending) {

@@ -32,8 +32,10 @@ use crate::plan::CostField;
 /// The suspect voxels of one flight and the voxels they forbid, over the field's region.
 #[derive(Clone, Debug, Default)]
 pub struct UnknownGuard {
-    /// Dense indices of the suspect voxels.
+    /// Dense indices of the suspect voxels next to a surface.
     suspects: FxHashSet<usize>,
+    /// Dense indices of the unknown voxels that lean occupied; kept while they still do.
+    leaning: FxHashSet<usize>,
     /// Per dense index: forbidden (a suspect within the vehicle's radius).
     forbidden: Vec<bool>,
     /// The indices set in `forbidden`, to clear them.
@@ -55,7 +57,11 @@ impl UnknownGuard {
         radius: f64,
         surface_reach: f64,
     ) {
-        if radius <= 0.0 && self.suspects.is_empty() && self.marked.is_empty() {
+        if radius <= 0.0
+            && self.suspects.is_empty()
+            && self.leaning.is_empty()
+            && self.marked.is_empty()
+        {
             // Off, and nothing left from before: nothing to forbid.
             return;
         }
@@ -76,6 +82,8 @@ impl UnknownGuard {
         }
         self.suspects
             .retain(|&index| field.class(index) == VoxelClass::Unknown);
+        self.leaning
+            .retain(|&index| field.class(index) == VoxelClass::Unknown);
 
         for &index in &self.marked {
             self.forbidden[index] = false;
@@ -84,7 +92,7 @@ impl UnknownGuard {
         self.forbidden.resize(region.len(), false);
         let pad = (field.config().vehicle_radius / size).ceil() as i64;
         let near = (field.config().vehicle_radius / size).powi(2) + 1e-9;
-        let mut suspects: Vec<usize> = self.suspects.iter().copied().collect();
+        let mut suspects: Vec<usize> = self.suspects.union(&self.leaning).copied().collect();
         suspects.sort_unstable();
         for index in suspects {
             let u = region.coordinates_at(index);
@@ -107,8 +115,10 @@ impl UnknownGuard {
 
     /// Adds as suspects the unknown voxels of `field` within `radius` metres of `position`
     /// whose memberships in `map` lean occupied: occupied membership at least `threshold` and
-    /// above the free membership. A threshold above 1 (or a radius of 0) adds nothing. Call
-    /// before [`UnknownGuard::update`], which turns suspects into forbidden voxels.
+    /// above the free membership. Drops, wherever they are, the ones added before that no
+    /// longer lean occupied (later frames saw through them). A threshold above 1 (or a radius
+    /// of 0) adds nothing. Call before [`UnknownGuard::update`], which turns suspects into
+    /// forbidden voxels.
     pub fn add_leaning(
         &mut self,
         map: &dyn VoxelMap,
@@ -117,6 +127,11 @@ impl UnknownGuard {
         radius: f64,
         threshold: f32,
     ) {
+        let leans = |index: usize| {
+            let m = map.memberships_at(field.region().key_at(index));
+            m.occupied >= threshold && m.occupied > m.free
+        };
+        self.leaning.retain(|&index| leans(index));
         if radius <= 0.0 || threshold.is_nan() || threshold > 1.0 {
             return;
         }
@@ -141,12 +156,11 @@ impl UnknownGuard {
                         continue;
                     }
                     let i = region.index_at(c);
-                    if field.class(i) != VoxelClass::Unknown || self.suspects.contains(&i) {
-                        continue;
-                    }
-                    let m = map.memberships_at(region.key_at(i));
-                    if m.occupied >= threshold && m.occupied > m.free {
-                        self.suspects.insert(i);
+                    if field.class(i) == VoxelClass::Unknown
+                        && !self.leaning.contains(&i)
+                        && leans(i)
+                    {
+                        self.leaning.insert(i);
                     }
                 }
             }
@@ -197,9 +211,9 @@ impl UnknownGuard {
         self.forbidden.get(index).copied().unwrap_or(false)
     }
 
-    /// Number of suspect voxels.
+    /// Number of suspect voxels (next to a surface, or leaning occupied).
     pub fn suspects(&self) -> usize {
-        self.suspects.len()
+        self.suspects.union(&self.leaning).count()
     }
 }
 
@@ -321,6 +335,23 @@ mod tests {
         assert!(!guard.forbids(index(12, 10, 5)));
         assert!(!guard.forbids(index(10, 20, 5)));
         assert!(!guard.forbids(index(20, 10, 5)));
+        // Later frames see through it (free above occupied): it no longer leans, and the
+        // guard lets it go, wherever the vehicle is.
+        let seen = FunctionMap::new(resolution, |key| match (key.x, key.y, key.z) {
+            (10, 10, 5) => Memberships {
+                occupied: 0.43,
+                free: 0.45,
+            },
+            _ => Memberships {
+                occupied: 0.0,
+                free: 0.95,
+            },
+        });
+        let far_away = resolution.center(VoxelKey::new(25, 25, 5));
+        guard.add_leaning(&seen, &field, &far_away, 3.0, 0.3);
+        guard.update(&field, &far_away, 0.0, 0.6);
+        assert_eq!(guard.suspects(), 0);
+        assert!(!guard.forbids(index(10, 10, 5)));
         // Out of reach, or off (a threshold above 1), nothing is added.
         let mut far = UnknownGuard::new();
         far.add_leaning(

@@ -2,7 +2,7 @@ use nalgebra::{Isometry3, Vector3};
 use rayon::prelude::*;
 
 use super::scene::Scene;
-use super::texture::{albedo, unit_hash};
+use super::texture::{albedo, scramble, unit_hash};
 use crate::depth::{Frame, GrayImage};
 use crate::error::Result;
 use crate::geometry::PinholeIntrinsics;
@@ -45,7 +45,7 @@ fn sun() -> Vector3<f64> {
 /// texture under a sun and ambient light, plus mild sensor noise; rays that meet nothing within
 /// `max_distance` see a smooth sky whose brightness depends only on elevation. Rows are
 /// rendered in parallel; the noise is a hash of `(seed, pixel)`, so the image is the same for
-/// any number of threads.
+/// any number of threads, and independent from one seed to another.
 pub fn render(
     scene: &Scene,
     intrinsics: &PinholeIntrinsics,
@@ -57,6 +57,8 @@ pub fn render(
     let origin = world_from_camera.translation.vector.into();
     let rotation = world_from_camera.rotation;
     let sun = sun();
+    // Independent noise for every seed, consecutive ones included (see `scramble`).
+    let noise_seed = scramble(seed);
     let rows: Vec<(Vec<f32>, Vec<f32>)> = (0..height)
         .into_par_iter()
         .map(|v| {
@@ -65,7 +67,7 @@ pub fn render(
             for u in 0..width {
                 let in_camera = intrinsics.back_project(f64::from(u), f64::from(v), 1.0);
                 let direction = rotation * in_camera.coords;
-                let noise = (unit_hash(i64::from(u), i64::from(v), 7, seed) - 0.5) * 0.02;
+                let noise = (unit_hash(i64::from(u), i64::from(v), 7, noise_seed) - 0.5) * 0.02;
                 match scene.cast_ray(&origin, &direction, max_distance) {
                     Some(hit) => {
                         let light = 0.35 + 0.65 * hit.normal.dot(&sun).max(0.0) as f32;
@@ -182,5 +184,44 @@ mod tests {
             "another seed, other noise"
         );
         assert!(bits(&other).1 == bits(&frames[0]).1, "the same true depth");
+    }
+
+    #[test]
+    fn consecutive_seeds_give_unrelated_noise() {
+        // Sky only: the image is the smooth sky plus the noise. Unscrambled, seeds that differ
+        // in their low bits gave the same noise with columns swapped (`u` xor the difference),
+        // a pattern that matched between consecutive frames.
+        let s = Scene::default();
+        let k = PinholeIntrinsics::new(64, 48, 60.0, 60.0, 31.5, 23.5).unwrap();
+        let pose = look_at(Point3::new(0.0, 0.0, 2.0), Vector3::new(1.0, 0.0, 0.3));
+        for (a, b) in [(2u64, 3u64), (16, 17), (31, 32), (64, 127)] {
+            let (fa, fb) = (
+                render(&s, &k, &pose, a, 100.0),
+                render(&s, &k, &pose, b, 100.0),
+            );
+            // The sky is the same in both, so the difference is the noises' difference; with
+            // the columns-swapped noise of the old hash, that difference at `u` and at
+            // `u ^ (a ^ b)` cancel exactly.
+            let swap = (a ^ b) as u32;
+            let d = |u: u32, v: u32| {
+                let i = (v * 64 + u) as usize;
+                fb.image[i] - fa.image[i]
+            };
+            let (mut cancel, mut compared) = (0, 0);
+            for v in 0..48u32 {
+                for u in 0..64u32 {
+                    let w = u ^ swap;
+                    if w < 64 && w != u {
+                        compared += 1;
+                        cancel += usize::from((d(u, v) + d(w, v)).abs() < 1e-6);
+                    }
+                }
+            }
+            assert!(compared > 0);
+            assert!(
+                cancel * 20 < compared,
+                "seeds {a}, {b}: {cancel} of {compared} cancel"
+            );
+        }
     }
 }

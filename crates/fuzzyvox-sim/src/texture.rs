@@ -17,6 +17,19 @@ pub(crate) fn hash3(x: i64, y: i64, z: i64, seed: u64) -> u64 {
     h ^ (h >> 29)
 }
 
+/// A seed scrambled by the same finaliser, for hashes that must be independent from one seed to
+/// the next. [`hash3`] takes its seed and its first coordinate by exclusive or before mixing, so
+/// seeds that differ in a few low bits give the same values at coordinates that differ in those
+/// bits: two frames rendered with such seeds carried the same sensor noise with columns swapped
+/// (`u` xor the seeds' difference), a pattern that stereo matched at a disparity of 1 to 63
+/// pixels wherever the image had no texture of its own (false surfaces 1-2 m in front of a
+/// camera that looked at the sky). Scrambling the seed first makes that relation land at
+/// coordinates far outside any image.
+#[inline]
+pub(crate) fn scramble(seed: u64) -> u64 {
+    hash3(0, 0, 0, seed)
+}
+
 /// A deterministic hash of an integer triple and a seed, mapped to `[0, 1)`: the texture's noise,
 /// and a seeded choice wherever one is needed (goals, flight queries).
 #[inline]
