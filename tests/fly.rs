@@ -4,7 +4,9 @@
 mod common;
 
 use common::{fuzzyvox, json};
-use fuzzyvox::fly::{Ending, FlyConfig, FlyModel, Goal, fly_all, fly_goal, integrate_prior};
+use fuzzyvox::fly::{
+    Ending, FlightLog, FlyConfig, FlyModel, Goal, fly_all, fly_goal, integrate_prior,
+};
 use fuzzyvox::sim::scenario::{self, Scenario};
 use fuzzyvox::sim::{Scene, SurfaceKind};
 use nalgebra::{Point3, Vector3};
@@ -76,31 +78,37 @@ fn one_box(name: &'static str, centre: Point3<f64>, half: Vector3<f64>) -> Scena
     }
 }
 
-#[test]
-fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
+/// A flight from above the hidden plate to a goal below it, with a level camera (no pitch
+/// towards the descending path) flying straight; `blind_steps` lets it step into unknown space
+/// below its view. Returns the plate, the start, the vehicle radius and the log.
+fn fly_down_past_the_plate(blind_steps: bool) -> (Scenario, Point3<f64>, f64, FlightLog) {
     let plate = hidden_plate();
     let goal = Goal {
         start: Point3::new(-0.9, 0.1, 5.5),
         goal: Point3::new(1.1, 0.1, 1.1),
         truth_length: 12.0,
     };
-    // A level camera (no pitch towards the descending path), flying straight, free to step
-    // into unknown space below its view.
     let config = FlyConfig {
         max_pitch: 0.0,
         weave_angle: 0.0,
         look_turn: 0.0,
-        blind_steps: true,
+        blind_steps,
         ..FlyConfig::default()
     };
     let mut map = FlyModel::LogOdds.new_map(config.resolution).unwrap();
     integrate_prior(&plate, &mut map, &goal.start, &config).unwrap();
     let log = fly_goal(&plate, &goal, &mut map, &config, 1).unwrap();
+    (plate, goal.start, config.planner.vehicle_radius, log)
+}
+
+#[test]
+fn a_flight_into_an_unseen_obstacle_is_stopped_and_counted() {
+    let (plate, _, radius, log) = fly_down_past_the_plate(true);
     assert_eq!(log.ending, Ending::Collided, "{:?}", log.trajectory);
     // Stopped before the step that meets the plate: every position flown is clear of it.
     let last = log.trajectory.last().unwrap();
     assert!(last.z > 3.0, "{last:?}");
-    assert!(plate.scene.distance_to_surface(last) >= config.planner.vehicle_radius);
+    assert!(plate.scene.distance_to_surface(last) >= radius);
 }
 
 #[test]
@@ -108,25 +116,11 @@ fn a_vehicle_enters_unknown_space_only_where_its_camera_looks() {
     // The flight above, with the default rule: the steps into unknown space head into the
     // level camera's picture, so the vehicle descends no more steeply than the picture
     // reaches, sees the plate, and never touches it.
-    let plate = hidden_plate();
-    let goal = Goal {
-        start: Point3::new(-0.9, 0.1, 5.5),
-        goal: Point3::new(1.1, 0.1, 1.1),
-        truth_length: 12.0,
-    };
-    let config = FlyConfig {
-        max_pitch: 0.0,
-        weave_angle: 0.0,
-        look_turn: 0.0,
-        ..FlyConfig::default()
-    };
-    let mut map = FlyModel::LogOdds.new_map(config.resolution).unwrap();
-    integrate_prior(&plate, &mut map, &goal.start, &config).unwrap();
-    let log = fly_goal(&plate, &goal, &mut map, &config, 1).unwrap();
+    let (_, start, _, log) = fly_down_past_the_plate(false);
     assert_ne!(log.ending, Ending::Collided, "{:?}", log.trajectory);
     // It did fly (down and out from under the start), not hover where it began.
     let last = log.trajectory.last().unwrap();
-    assert!((last - goal.start).norm() > 2.0, "{:?}", log.trajectory);
+    assert!((last - start).norm() > 2.0, "{:?}", log.trajectory);
 }
 
 /// A building face 4 m ahead of the start, across the way to a goal behind it: beyond the prior
