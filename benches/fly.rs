@@ -6,11 +6,17 @@
 //! depth stage, integration, cost-field update, path check or replanning), on a fresh copy of
 //! the state. Rendering the frame (the simulator's work) is outside the measured loop.
 //! `field/update_after_one_frame` updates the planner's field after that frame;
+//! `field/update_and_path_check_after_one_frame` updates it and checks that the path flown so
+//! far is still clear (what a frame that keeps its path does; the bench prints whether the
+//! measured frame does);
+//! `field/update_and_astar_after_one_frame` updates it and plans from scratch (A*) from the
+//! vehicle's position to its goal (what a frame whose path is blocked does);
 //! `field/full_rebuild` builds the same field from scratch.
 //!
 //! Run: `cargo bench --bench fly`.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use fuzzyvox::VoxelKey;
 use fuzzyvox::fly::{Flight, FlyConfig, FlyModel, draw_goals, integrate_prior};
 use fuzzyvox::plan::CostField;
 use fuzzyvox::sim::scenario;
@@ -35,6 +41,28 @@ fn cycle(c: &mut Criterion) {
         let (mut after, mut seen) = (flight.clone(), map.clone());
         after.see(frame.clone(), &mut seen).expect("see");
 
+        // The replan's endpoints: the vehicle's voxel and the goal's.
+        let resolution = after.planner().field().resolution();
+        let start: VoxelKey = resolution.key_of(&after.position()).expect("start key");
+        let target: VoxelKey = resolution.key_of(&goal.goal).expect("goal key");
+        let path = flight
+            .path()
+            .expect("a path before the measured frame")
+            .to_vec();
+        {
+            let mut planner = flight.planner().clone();
+            planner.update(seen.as_map());
+            let keeps = planner.is_clear(&path);
+            eprintln!(
+                "{}: the measured frame {} its path",
+                model.name(),
+                if keeps { "keeps" } else { "replans" }
+            );
+            planner
+                .plan(start, target)
+                .expect("the measured replan finds a path");
+        }
+
         let mut group = c.benchmark_group(format!("fly_320x240_{}", model.name()));
         group.sample_size(20);
         group.bench_function("cycle", |b| {
@@ -52,6 +80,26 @@ fn cycle(c: &mut Criterion) {
             b.iter_batched_ref(
                 || flight.planner().clone(),
                 |planner| planner.update(seen.as_map()),
+                BatchSize::LargeInput,
+            )
+        });
+        group.bench_function("field/update_and_path_check_after_one_frame", |b| {
+            b.iter_batched_ref(
+                || flight.planner().clone(),
+                |planner| {
+                    planner.update(seen.as_map());
+                    planner.is_clear(&path)
+                },
+                BatchSize::LargeInput,
+            )
+        });
+        group.bench_function("field/update_and_astar_after_one_frame", |b| {
+            b.iter_batched_ref(
+                || flight.planner().clone(),
+                |planner| {
+                    planner.update(seen.as_map());
+                    planner.plan(start, target)
+                },
                 BatchSize::LargeInput,
             )
         });
