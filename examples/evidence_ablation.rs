@@ -133,7 +133,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     (
                         format!("{:.2}", f.plan_success),
                         f.plan_collisions.to_string(),
-                        format!("{}/{}, {}", p.start_unsafe, p.goal_unsafe, p.disconnected),
+                        format!(
+                            "{}/{}, {} (unknown {}, occupied {}, ambiguous {}, low safety {})",
+                            p.start_unsafe,
+                            p.goal_unsafe,
+                            p.disconnected,
+                            p.blocked_by.unknown + p.blocked_by.outside_extent,
+                            p.blocked_by.occupied,
+                            p.blocked_by.ambiguous,
+                            p.blocked_by.low_safety
+                        ),
                     )
                 });
         println!(

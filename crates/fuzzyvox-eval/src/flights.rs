@@ -15,7 +15,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::map::VoxelMap;
 use crate::measures::VoxelClass;
-use crate::plan::{PlanError, PlannerConfig, plan_path};
+use crate::plan::{Blocker, PlanError, PlannerConfig, plan_path};
 use crate::sim::Scene;
 use crate::sim::unit_hash;
 use crate::storage::VoxelKey;
@@ -71,6 +71,46 @@ pub struct FlightOutcome {
     pub collides: bool,
     /// Why the planner found no path; `None` when it found one.
     pub failure: Option<FlightFailure>,
+    /// For an unsafe start or goal: what blocks it.
+    pub blocked_by: Option<BlockingClass>,
+}
+
+/// What makes an unsafe start or goal unsafe: the class of its own voxel when that may not be
+/// entered, otherwise (too little clearance) the class of the blocked voxel nearest to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockingClass {
+    /// The point lies outside the box of everything the map observed.
+    OutsideExtent,
+    /// Unknown space (forbidden).
+    Unknown,
+    /// Occupied space.
+    Occupied,
+    /// Ambiguous space (conflicting evidence).
+    Ambiguous,
+    /// Free space whose safety is below the planner's threshold.
+    LowSafety,
+}
+
+impl BlockingClass {
+    /// The class behind a planner's [`Blocker`]; `None` when the nearest blocked space is the
+    /// edge of the planning region.
+    pub fn of(blocker: &Blocker) -> Option<Self> {
+        let of_class = |class: VoxelClass| match class {
+            VoxelClass::Unknown => Self::Unknown,
+            VoxelClass::Occupied => Self::Occupied,
+            VoxelClass::Ambiguous => Self::Ambiguous,
+            VoxelClass::Free => Self::LowSafety,
+        };
+        match blocker {
+            Blocker::OutsideObservedExtent { .. } => Some(Self::OutsideExtent),
+            Blocker::Unknown => Some(Self::Unknown),
+            Blocker::Occupied { .. } => Some(Self::Occupied),
+            Blocker::Ambiguous { .. } => Some(Self::Ambiguous),
+            Blocker::LowSafety { .. } => Some(Self::LowSafety),
+            Blocker::TooClose { nearest, .. } => nearest.map(|n| of_class(n.class)),
+            _ => None,
+        }
+    }
 }
 
 /// Why a map gave no path for a query.
@@ -114,6 +154,24 @@ pub struct FailureCounts {
     pub out_of_region: usize,
     /// The planner refused the request (a map or configuration error; 0 in a sound run).
     pub error: usize,
+    /// The unsafe starts and goals by what blocks them.
+    pub blocked_by: BlockedByCounts,
+}
+
+/// Unsafe starts and goals by what blocks them ([`BlockingClass`]; `blocked_by` in
+/// `metrics.json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct BlockedByCounts {
+    /// Outside the map's observed extent.
+    pub outside_extent: usize,
+    /// Unknown space in or near the point.
+    pub unknown: usize,
+    /// Occupied space in or near it.
+    pub occupied: usize,
+    /// Ambiguous space in or near it.
+    pub ambiguous: usize,
+    /// Free space of low safety in or near it.
+    pub low_safety: usize,
 }
 
 impl FailureCounts {
@@ -126,6 +184,16 @@ impl FailureCounts {
                 FlightFailure::Disconnected => &mut counts.disconnected,
                 FlightFailure::OutOfRegion => &mut counts.out_of_region,
                 FlightFailure::Error => &mut counts.error,
+            } += 1;
+        }
+        for class in outcomes.iter().filter_map(|o| o.blocked_by) {
+            let b = &mut counts.blocked_by;
+            *match class {
+                BlockingClass::OutsideExtent => &mut b.outside_extent,
+                BlockingClass::Unknown => &mut b.unknown,
+                BlockingClass::Occupied => &mut b.occupied,
+                BlockingClass::Ambiguous => &mut b.ambiguous,
+                BlockingClass::LowSafety => &mut b.low_safety,
             } += 1;
         }
         counts
@@ -265,6 +333,7 @@ pub fn fly(
                     waypoints: Some(path.waypoints),
                     collides,
                     failure: None,
+                    blocked_by: None,
                 }
             }
             Err(error) => FlightOutcome {
@@ -272,6 +341,7 @@ pub fn fly(
                 length: None,
                 collides: false,
                 failure: Some(FlightFailure::of(&error)),
+                blocked_by: error.blocker().and_then(BlockingClass::of),
             },
         })
         .collect()
@@ -406,5 +476,21 @@ mod tests {
         assert_eq!(failed[0].failure, Some(FlightFailure::GoalUnsafe));
         assert_eq!(summarize(&failed, &failed).plan_failures.goal_unsafe, 1);
         assert_eq!(summarize(&failed, &failed).path_length_ratio, None);
+        // A goal on the wall's face is blocked by the occupied voxels the sensor saw there.
+        let onto = FlightQuery {
+            from: safe.from,
+            to: Point3::new(5.0, 0.0, 3.0),
+        };
+        let failed = fly(&map, &scene, &[onto], &planner);
+        assert_eq!(failed[0].failure, Some(FlightFailure::GoalUnsafe));
+        assert_eq!(failed[0].blocked_by, Some(BlockingClass::Occupied));
+        let counts = summarize(&failed, &failed).plan_failures.blocked_by;
+        assert_eq!(
+            counts,
+            BlockedByCounts {
+                occupied: 1,
+                ..BlockedByCounts::default()
+            }
+        );
     }
 }

@@ -54,8 +54,8 @@ pub use experiment::{
 };
 pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
 pub use flights::{
-    FailureCounts, FlightConfig, FlightFailure, FlightOutcome, FlightQuery, FlightSummary,
-    flight_queries, fly, summarize,
+    BlockedByCounts, BlockingClass, FailureCounts, FlightConfig, FlightFailure, FlightOutcome,
+    FlightQuery, FlightSummary, flight_queries, fly, summarize,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};

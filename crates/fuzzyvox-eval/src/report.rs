@@ -197,10 +197,13 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput, charts: &[&str])
              (truly free space that the cameras saw, clear of every surface), planned in each \
              map and checked against the true geometry with the vehicle's radius swept along \
              every segment. A map in which the start or goal is not safe fails that query; the \
-             failures are counted by reason. Length ratio: mean path length over the length of \
-             the path planned in the ground-truth (gold-standard) map.\n\n\
+             failures are counted by reason, and the unsafe starts and goals by what blocks \
+             them (the class of the point's voxel, or of the blocked voxel nearest to it). \
+             Length ratio: mean path length over the length of the path planned in the \
+             ground-truth (gold-standard) map.\n\n\
              | map | queries | success | collisions | length ratio | start not safe | goal not \
-             safe | disconnected | outside the region |\n|---|---|---|---|---|---|---|---|---|"
+             safe | disconnected | outside the region | blocked by: unknown / occupied / \
+             ambiguous / low safety |\n|---|---|---|---|---|---|---|---|---|---|"
         );
         let rows = report
             .truth_flights
@@ -216,7 +219,7 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput, charts: &[&str])
             let failed = &f.plan_failures;
             let _ = writeln!(
                 md,
-                "| {map_name} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
+                "| {map_name} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} / {} / {} / {} |",
                 f.plan_queries,
                 f.plan_success,
                 f.plan_collisions,
@@ -225,7 +228,11 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput, charts: &[&str])
                 failed.start_unsafe,
                 failed.goal_unsafe,
                 failed.disconnected,
-                failed.out_of_region + failed.error
+                failed.out_of_region + failed.error,
+                failed.blocked_by.unknown + failed.blocked_by.outside_extent,
+                failed.blocked_by.occupied,
+                failed.blocked_by.ambiguous,
+                failed.blocked_by.low_safety
             );
         }
         let _ = writeln!(md);
