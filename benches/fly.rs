@@ -16,7 +16,6 @@
 //! Run: `cargo bench --bench fly`.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use fuzzyvox::VoxelKey;
 use fuzzyvox::fly::{Flight, FlyConfig, FlyModel, draw_goals, integrate_prior};
 use fuzzyvox::plan::CostField;
 use fuzzyvox::sim::scenario;
@@ -43,8 +42,8 @@ fn cycle(c: &mut Criterion) {
 
         // The replan's endpoints: the vehicle's voxel and the goal's.
         let resolution = after.planner().field().resolution();
-        let start: VoxelKey = resolution.key_of(&after.position()).expect("start key");
-        let target: VoxelKey = resolution.key_of(&goal.goal).expect("goal key");
+        let start = resolution.key_of(&after.position()).expect("start key");
+        let target = resolution.key_of(&goal.goal).expect("goal key");
         let path = flight
             .path()
             .expect("a path before the measured frame")

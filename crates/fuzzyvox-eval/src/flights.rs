@@ -375,6 +375,7 @@ mod tests {
     use super::*;
     use crate::map::VoxelMapMut;
     use crate::map::{FuzzyConfig, FuzzyMap};
+    use crate::plan::NearestBlocked;
     use crate::sim::SurfaceKind;
     use fuzzyvox_core::PointCloud;
     use nalgebra::Vector3;
@@ -438,6 +439,40 @@ mod tests {
         assert_eq!(summary.plan_success, 0.0);
         assert_eq!(summary.plan_failures.start_unsafe, a.len());
         assert_eq!(summary.plan_failures.goal_unsafe, 0);
+    }
+
+    #[test]
+    fn a_point_short_of_clearance_is_blocked_by_the_class_of_its_nearest_blocked_voxel() {
+        let too_close = |nearest: Option<NearestBlocked>| Blocker::TooClose {
+            clearance: 0.2,
+            required: 0.47,
+            vehicle_radius: 0.3,
+            largest_radius: 0.03,
+            nearest,
+        };
+        let near = |class| NearestBlocked {
+            center: Point3::origin(),
+            class,
+            safety: 0.1,
+            distance: 0.2,
+        };
+        for (class, expected) in [
+            (VoxelClass::Unknown, BlockingClass::Unknown),
+            (VoxelClass::Occupied, BlockingClass::Occupied),
+            (VoxelClass::Ambiguous, BlockingClass::Ambiguous),
+            (VoxelClass::Free, BlockingClass::LowSafety),
+        ] {
+            assert_eq!(
+                BlockingClass::of(&too_close(Some(near(class)))),
+                Some(expected)
+            );
+        }
+        // The planning region's edge is no class.
+        assert_eq!(BlockingClass::of(&too_close(None)), None);
+        assert_eq!(
+            BlockingClass::of(&Blocker::Unknown),
+            Some(BlockingClass::Unknown)
+        );
     }
 
     #[test]

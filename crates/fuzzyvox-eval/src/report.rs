@@ -198,7 +198,8 @@ pub fn markdown(scenario: &Scenario, output: &ExperimentOutput, charts: &[&str])
              map and checked against the true geometry with the vehicle's radius swept along \
              every segment. A map in which the start or goal is not safe fails that query; the \
              failures are counted by reason, and the unsafe starts and goals by what blocks \
-             them (the class of the point's voxel, or of the blocked voxel nearest to it). \
+             them (the class of the point's voxel, or of the blocked voxel nearest to it; a point \
+             outside everything the map observed counts as unknown). \
              Length ratio: mean path length over the length of the path planned in the \
              ground-truth (gold-standard) map.\n\n\
              | map | queries | success | collisions | length ratio | start not safe | goal not \
