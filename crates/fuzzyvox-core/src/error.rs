@@ -102,6 +102,16 @@ pub enum Error {
     /// One item of a list that must not repeat was given twice (an experiment's operators).
     #[error("{0} is listed twice")]
     Duplicate(String),
+    /// A name (of a map model, a scenario, ...) that is not one of those known.
+    #[error("unknown {what} `{name}`: expected {expected}")]
+    UnknownName {
+        /// What the name should name.
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The names known.
+        expected: &'static str,
+    },
     /// Two maps cannot be combined.
     #[error("maps are incompatible: {0}")]
     Incompatible(String),

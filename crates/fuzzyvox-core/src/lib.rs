@@ -62,8 +62,8 @@ pub use integrate::{
     IntervalDepthImage, PointCloud, ScanEvidence,
 };
 pub use map::{
-    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
-    VoxelCounts, VoxelMap, VoxelMapMut,
+    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, MapKind,
+    MapOptions, VoxelCounts, VoxelMap, VoxelMapMut,
 };
 pub use measures::{ClassThresholds, MeasureConfig, Measures, Memberships, VoxelClass};
 pub use ops::{Complement, Family, Hedge, TConorm, TNorm};

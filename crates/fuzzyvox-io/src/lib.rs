@@ -40,6 +40,7 @@ pub mod rgbd;
 pub mod rgbd_write;
 
 pub use cloud_text::{parse_text_cloud, read_text_cloud};
-pub use fuzzyvox_core::file::{MapHeader, MapKind, read_header, write_atomic};
+pub use fuzzyvox_core::file::{MapHeader, read_header, write_atomic};
+pub use fuzzyvox_core::map::MapKind;
 pub use gray::{decode_gray_image, read_gray_image};
 pub use load::{LoadedMap, MapFormat, load_map};

@@ -2,7 +2,8 @@
 
 use std::path::Path;
 
-use super::mapfile::{MapHeader, MapKind, from_memory, read_checked, split};
+use super::mapfile::{MapHeader, from_memory, read_checked, split};
+use crate::map::MapKind;
 use crate::error::{Error, Result};
 use crate::map::{AlphaCutMap, AnyMap, FuzzyMap, LogOddsMap};
 
@@ -57,15 +58,6 @@ impl AnyMap {
             Self::Fuzzy(m) => m.to_bytes(),
             Self::LogOdds(m) => m.to_bytes(),
             Self::Alpha(m) => m.to_bytes(),
-        }
-    }
-
-    /// Which kind of map this is.
-    pub fn kind(&self) -> MapKind {
-        match self {
-            Self::Fuzzy(_) => MapKind::Fuzzy,
-            Self::LogOdds(_) => MapKind::LogOdds,
-            Self::Alpha(_) => MapKind::AlphaCut,
         }
     }
 }

@@ -1,6 +1,7 @@
 use serde::{Deserialize, Serialize};
 
-use super::mapfile::{self, MapKind};
+use super::mapfile;
+use crate::map::MapKind;
 use super::stored_blocks::{self, StoredBlock};
 use crate::error::{FormatError, Result};
 use crate::integrate::EvidenceModel;

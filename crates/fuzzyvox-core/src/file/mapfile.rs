@@ -20,6 +20,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::error::{Error, FormatError, Result};
+use crate::map::MapKind;
 use crate::ops::Family;
 
 /// The first eight bytes of every native map file.
@@ -34,42 +35,22 @@ const OLDEST_VERSION: u16 = 1;
 const HEADER_LEN: usize = 40;
 const NO_OPERATOR: u8 = 255;
 
-/// Which map a file holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum MapKind {
-    /// The dual-set fuzzy map.
-    Fuzzy,
-    /// The log-odds map (OctoMap semantics).
-    LogOdds,
-    /// The alpha-cut log-odds map.
-    AlphaCut,
+/// The kind's code in a file header.
+fn code_of(kind: MapKind) -> u8 {
+    match kind {
+        MapKind::Fuzzy => 1,
+        MapKind::LogOdds => 2,
+        MapKind::AlphaCut => 3,
+    }
 }
 
-impl MapKind {
-    fn code(self) -> u8 {
-        match self {
-            Self::Fuzzy => 1,
-            Self::LogOdds => 2,
-            Self::AlphaCut => 3,
-        }
-    }
-
-    fn from_code(code: u8) -> Option<Self> {
-        match code {
-            1 => Some(Self::Fuzzy),
-            2 => Some(Self::LogOdds),
-            3 => Some(Self::AlphaCut),
-            _ => None,
-        }
-    }
-
-    /// Lower-case name (`fuzzy`, `logodds`, `alpha`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Fuzzy => "fuzzy",
-            Self::LogOdds => "logodds",
-            Self::AlphaCut => "alpha",
-        }
+/// The kind a file header's code names.
+fn kind_of_code(code: u8) -> Option<MapKind> {
+    match code {
+        1 => Some(MapKind::Fuzzy),
+        2 => Some(MapKind::LogOdds),
+        3 => Some(MapKind::AlphaCut),
+        _ => None,
     }
 }
 
@@ -123,7 +104,7 @@ pub(crate) fn encode<T: Serialize>(
     let mut bytes = Vec::with_capacity(HEADER_LEN + body.len());
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&VERSION.to_le_bytes());
-    bytes.push(kind.code());
+    bytes.push(code_of(kind));
     bytes.push(code);
     bytes.extend_from_slice(&parameter.to_le_bytes());
     bytes.extend_from_slice(&resolution.to_le_bytes());
@@ -168,7 +149,7 @@ pub(crate) fn split(bytes: &[u8]) -> Result<(MapHeader, &[u8]), FormatError> {
         return Err(FormatError::Checksum { stored, computed });
     }
     let [kind_code, operator_code] = field(header, 10);
-    let kind = MapKind::from_code(kind_code)
+    let kind = kind_of_code(kind_code)
         .ok_or_else(|| FormatError::Invalid(format!("unknown map kind code {kind_code}")))?;
     let parameter = f64::from_le_bytes(field(header, 12));
     let operator = match operator_code {

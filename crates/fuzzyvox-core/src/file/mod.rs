@@ -17,4 +17,4 @@ mod mapfile;
 mod stored_blocks;
 
 pub use atomic::{write_atomic, write_atomic_with};
-pub use mapfile::{MAGIC, MapHeader, MapKind, read_checked, read_header};
+pub use mapfile::{MAGIC, MapHeader, read_checked, read_header};

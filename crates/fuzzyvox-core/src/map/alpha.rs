@@ -18,11 +18,14 @@ pub struct AlphaConfig {
 }
 
 impl AlphaConfig {
-    /// OctoMap's defaults with 10 cuts at `resolution` metres.
+    /// The default number of confidence cuts.
+    pub const DEFAULT_CUTS: u32 = 10;
+
+    /// OctoMap's defaults with [`AlphaConfig::DEFAULT_CUTS`] cuts at `resolution` metres.
     pub fn new(resolution: f64) -> Result<Self> {
         Ok(Self {
             logodds: LogOddsConfig::new(resolution)?,
-            cuts: 10,
+            cuts: Self::DEFAULT_CUTS,
         })
     }
 
