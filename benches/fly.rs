@@ -16,7 +16,10 @@
 //! Run: `cargo bench --bench fly`.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use fuzzyvox::fly::{Flight, FlyConfig, FlyModel, draw_goals, integrate_prior};
+use fuzzyvox::MapKind;
+use fuzzyvox::eval::QueryConfig;
+use fuzzyvox::eval::closed_loop::draw_goals;
+use fuzzyvox::fly::{Flight, FlyConfig, integrate_prior};
 use fuzzyvox::plan::CostField;
 use fuzzyvox::sim::scenario;
 
@@ -26,11 +29,13 @@ const WARM_UP_CYCLES: usize = 6;
 fn cycle(c: &mut Criterion) {
     let scenario = scenario::random(10, 3).expect("scenario");
     let config = FlyConfig::default();
-    let goal = draw_goals(&scenario, &config, 1, 3).expect("goals")[0];
-    for model in [FlyModel::Fuzzy, FlyModel::LogOdds] {
+    let queries = QueryConfig::closed_loop(1, 3, config.planner);
+    let goal = draw_goals(&scenario, &config, &queries).expect("goals")[0];
+    for model in [MapKind::Fuzzy, MapKind::LogOdds] {
         let mut map = model.new_map(config.resolution).expect("map");
-        integrate_prior(&scenario, &mut map, &goal.start, &config).expect("prior");
-        let mut flight = Flight::new(&scenario, &goal, &map, &config, 3).expect("flight");
+        integrate_prior(&scenario, &mut map, &goal.from, &config).expect("prior");
+        let mut flight =
+            Flight::new(&scenario, &goal.from, &goal.to, &map, &config, 3).expect("flight");
         for _ in 0..WARM_UP_CYCLES {
             flight.cycle(&mut map).expect("cycle");
         }
@@ -43,7 +48,7 @@ fn cycle(c: &mut Criterion) {
         // The replan's endpoints: the vehicle's voxel and the goal's.
         let resolution = after.planner().field().resolution();
         let start = resolution.key_of(&after.position()).expect("start key");
-        let target = resolution.key_of(&goal.goal).expect("goal key");
+        let target = resolution.key_of(&goal.to).expect("goal key");
         let path = flight
             .path()
             .expect("a path before the measured frame")

@@ -11,7 +11,7 @@
 //! Arguments: scenario (`wall` or `random`), pairs (the random flight's), seed, planned
 //! flights, then variants (default: the paper's model and the dual model's parts one by one).
 
-use fuzzyvox::eval::{ExperimentConfig, FlightConfig, run_experiment};
+use fuzzyvox::eval::{ExperimentConfig, QueryConfig, run_experiment};
 use fuzzyvox::plan::PlannerConfig;
 use fuzzyvox::sim::scenario;
 use fuzzyvox::{EvidenceKind, EvidenceModel, FuzzyConfig};
@@ -101,13 +101,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .iter()
             .map(|(n, m)| Ok((n.clone(), FuzzyConfig::new(0.2)?.with_evidence(*m))))
             .collect::<fuzzyvox::Result<_>>()?,
-        flights: (flights > 0).then(|| FlightConfig {
+        flights: (flights > 0).then(|| QueryConfig {
             queries: flights,
             seed,
             altitude: scenario.flight_altitude,
             distance: scenario.flight_distance,
             planner: PlannerConfig::default(),
-            ..FlightConfig::default()
+            ..QueryConfig::default()
         }),
         ..ExperimentConfig::default()
     };

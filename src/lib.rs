@@ -48,7 +48,7 @@ pub use fuzzyvox_core::{
     AlphaConfig, AlphaCutMap, AnyMap, BlockGrid, BlockKey, ClassThresholds, Complement, DepthFrame,
     Error, Evidence, EvidenceKind, EvidenceModel, Family, FormatError, FuzzyConfig, FuzzyMap,
     Hedge, IntegrationOptions, IntegrationStats, IntervalDepthImage, KeyBox, LogOddsConfig,
-    LogOddsMap, MeasureConfig, Measures, Memberships, PinholeIntrinsics, PointCloud, Resolution,
-    Result, ScanEvidence, TConorm, TNorm, VoxelClass, VoxelCounts, VoxelKey, VoxelMap, VoxelMapMut,
-    pose_from_matrix, validate_pose,
+    LogOddsMap, MapKind, MapOptions, MeasureConfig, Measures, Memberships, PinholeIntrinsics,
+    PointCloud, Resolution, Result, ScanEvidence, TConorm, TNorm, VoxelClass, VoxelCounts,
+    VoxelKey, VoxelMap, VoxelMapMut, pose_from_matrix, validate_pose,
 };

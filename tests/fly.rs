@@ -4,9 +4,10 @@
 mod common;
 
 use common::{fuzzyvox, json};
-use fuzzyvox::fly::{
-    Ending, FlightLog, FlyConfig, FlyModel, Goal, fly_all, fly_goal, integrate_prior,
-};
+use fuzzyvox::MapKind;
+use fuzzyvox::eval::FlightQuery;
+use fuzzyvox::eval::closed_loop::fly_all;
+use fuzzyvox::fly::{Ending, FlightLog, FlyConfig, fly_goal, integrate_prior};
 use fuzzyvox::sim::scenario::{self, Scenario};
 use fuzzyvox::sim::{Scene, SurfaceKind};
 use nalgebra::{Point3, Vector3};
@@ -22,17 +23,17 @@ fn strip_times(mut logs: Vec<fuzzyvox::fly::FlightLog>) -> Vec<fuzzyvox::fly::Fl
 #[test]
 fn a_flight_is_the_same_for_the_same_seed() {
     let wall = scenario::wall().unwrap();
-    let goal = Goal {
-        start: Point3::new(-5.9, -12.3, 2.7),
-        goal: Point3::new(3.7, -15.3, 4.7),
-        truth_length: 10.25,
+    let goal = FlightQuery {
+        from: Point3::new(-5.9, -12.3, 2.7),
+        to: Point3::new(3.7, -15.3, 4.7),
+        reference_length: Some(10.25),
     };
     let config = FlyConfig::default();
     let run = || {
         let flights = fly_all(
             &wall,
             &[goal],
-            &[FlyModel::Fuzzy],
+            &[MapKind::Fuzzy],
             &config,
             3,
             false,
@@ -45,7 +46,7 @@ fn a_flight_is_the_same_for_the_same_seed() {
     assert_eq!(a, b);
     let flight = &a[0];
     assert!(flight.frames > 5 && flight.depth_images > 0, "{flight:?}");
-    assert_eq!(flight.trajectory[0], goal.start);
+    assert_eq!(flight.trajectory[0], goal.from);
 }
 
 /// A 10 × 10 m plate 2.5 m under the start, which a level camera never sees (it lies below the
@@ -83,10 +84,10 @@ fn one_box(name: &'static str, centre: Point3<f64>, half: Vector3<f64>) -> Scena
 /// below its view. Returns the plate, the start, the vehicle radius and the log.
 fn fly_down_past_the_plate(blind_steps: bool) -> (Scenario, Point3<f64>, f64, FlightLog) {
     let plate = hidden_plate();
-    let goal = Goal {
-        start: Point3::new(-0.9, 0.1, 5.5),
-        goal: Point3::new(1.1, 0.1, 1.1),
-        truth_length: 12.0,
+    let goal = FlightQuery {
+        from: Point3::new(-0.9, 0.1, 5.5),
+        to: Point3::new(1.1, 0.1, 1.1),
+        reference_length: Some(12.0),
     };
     let config = FlyConfig {
         max_pitch: 0.0,
@@ -95,10 +96,10 @@ fn fly_down_past_the_plate(blind_steps: bool) -> (Scenario, Point3<f64>, f64, Fl
         blind_steps,
         ..FlyConfig::default()
     };
-    let mut map = FlyModel::LogOdds.new_map(config.resolution).unwrap();
-    integrate_prior(&plate, &mut map, &goal.start, &config).unwrap();
-    let log = fly_goal(&plate, &goal, &mut map, &config, 1).unwrap();
-    (plate, goal.start, config.planner.vehicle_radius, log)
+    let mut map = MapKind::LogOdds.new_map(config.resolution).unwrap();
+    integrate_prior(&plate, &mut map, &goal.from, &config).unwrap();
+    let log = fly_goal(&plate, &goal.from, &goal.to, &mut map, &config, 1).unwrap();
+    (plate, goal.from, config.planner.vehicle_radius, log)
 }
 
 #[test]
@@ -125,16 +126,16 @@ fn a_vehicle_enters_unknown_space_only_where_its_camera_looks() {
 
 /// A building face 4 m ahead of the start, across the way to a goal behind it: beyond the prior
 /// map, and straight ahead, where motion along the view measures almost nothing.
-fn wall_ahead() -> (Scenario, Goal) {
+fn wall_ahead() -> (Scenario, FlightQuery) {
     let scenario = one_box(
         "wall ahead",
         Point3::new(4.5, 0.0, 3.0),
         Vector3::new(0.3, 2.0, 3.0),
     );
-    let goal = Goal {
-        start: Point3::new(0.0, 0.3, 2.1),
-        goal: Point3::new(9.0, 0.3, 2.1),
-        truth_length: 12.0,
+    let goal = FlightQuery {
+        from: Point3::new(0.0, 0.3, 2.1),
+        to: Point3::new(9.0, 0.3, 2.1),
+        reference_length: Some(12.0),
     };
     (scenario, goal)
 }
@@ -147,9 +148,9 @@ fn looking_aside_at_take_off_sees_the_wall_that_forward_motion_misses() {
             look_turn,
             ..FlyConfig::default()
         };
-        let mut map = FlyModel::Fuzzy.new_map(config.resolution).unwrap();
-        integrate_prior(&scenario, &mut map, &goal.start, &config).unwrap();
-        fly_goal(&scenario, &goal, &mut map, &config, 5).unwrap()
+        let mut map = MapKind::Fuzzy.new_map(config.resolution).unwrap();
+        integrate_prior(&scenario, &mut map, &goal.from, &config).unwrap();
+        fly_goal(&scenario, &goal.from, &goal.to, &mut map, &config, 5).unwrap()
     };
     // Flying straight at it, the vehicle sees the face only from along its view and hits it.
     let straight = fly(0.0);
@@ -184,15 +185,15 @@ fn a_flight_that_comes_no_nearer_ends_as_stuck() {
         Point3::new(6.0, 0.0, 3.0),
         Vector3::new(1.5, 1.5, 3.0),
     );
-    let goal = Goal {
-        start: Point3::new(0.0, 0.3, 2.1),
-        goal: Point3::new(6.0, 0.3, 2.1),
-        truth_length: 6.0,
+    let goal = FlightQuery {
+        from: Point3::new(0.0, 0.3, 2.1),
+        to: Point3::new(6.0, 0.3, 2.1),
+        reference_length: Some(6.0),
     };
     let config = FlyConfig::default();
-    let mut map = FlyModel::Fuzzy.new_map(config.resolution).unwrap();
-    integrate_prior(&scenario, &mut map, &goal.start, &config).unwrap();
-    let log = fly_goal(&scenario, &goal, &mut map, &config, 2).unwrap();
+    let mut map = MapKind::Fuzzy.new_map(config.resolution).unwrap();
+    integrate_prior(&scenario, &mut map, &goal.from, &config).unwrap();
+    let log = fly_goal(&scenario, &goal.from, &goal.to, &mut map, &config, 2).unwrap();
     assert_eq!(log.ending, Ending::Stuck, "{:?}", log.trajectory);
     // It gave the vehicle `patience` seconds, and ended long before the time limit.
     let frames = (config.patience / config.frame_interval) as usize;

@@ -4,16 +4,18 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::VoxelClass;
-use fuzzyvox::eval::{file_stem, report_html, write_experiment};
-use fuzzyvox::fly::{
-    FlyConfig, FlyModel, draw_goals, flights_json, flights_markdown, fly_all, write_flight_figures,
+use fuzzyvox::eval::QueryConfig;
+use fuzzyvox::eval::closed_loop::{
+    ClosedLoopReport, draw_goals, flights_markdown, fly_all, write_flight_figures,
 };
+use fuzzyvox::eval::{file_stem, report_html, write_experiment};
+use fuzzyvox::fly::FlyConfig;
 use fuzzyvox::io::octomap::write_bt_max_likelihood;
 use fuzzyvox::io::ply::{PlyEncoding, write_ply};
 use fuzzyvox::ops::Family;
 use fuzzyvox::plan::UnknownPolicy;
 use fuzzyvox::sim::scenario;
+use fuzzyvox::{MapKind, VoxelClass};
 
 use super::eval::{experiment_config, run_with_bar};
 use super::maps::Evidence;
@@ -94,15 +96,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         let mut metrics = serde_json::to_value(&output.report)?;
         // A short closed-loop flight: each map flies to one goal through the scene, mapping
         // with depth from the vehicle's own motion.
-        let fly_config = FlyConfig {
+        let fly_config = FlyConfig::default();
+        let queries = QueryConfig {
             distance: (6.0, 10.0),
-            ..FlyConfig::default()
+            ..QueryConfig::closed_loop(1, 1, fly_config.planner)
         };
-        let goals = draw_goals(&scenario, &fly_config, 1, 1)?;
+        let goals = draw_goals(&scenario, &fly_config, &queries)?;
         let flights = fly_all(
             &scenario,
             &goals,
-            &FlyModel::ALL,
+            &MapKind::ALL,
             &fly_config,
             1,
             true,
@@ -117,7 +120,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             &flights,
             Some(&figure_name),
         ));
-        metrics["closed_loop"] = flights_json(&goals, &fly_config, &flights);
+        metrics["closed_loop"] = serde_json::to_value(ClosedLoopReport::new(
+            &goals,
+            &fly_config,
+            &queries,
+            &flights,
+        ))?;
         all.insert(scenario.name.to_string(), metrics);
     }
     let _ = writeln!(

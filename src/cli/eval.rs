@@ -5,7 +5,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use fuzzyvox::Family;
 use fuzzyvox::eval::{
-    ExperimentConfig, FlightConfig, run_experiment_with_progress, write_experiment,
+    ExperimentConfig, QueryConfig, run_experiment_with_progress, write_experiment,
 };
 use fuzzyvox::plan::{PlannerConfig, UnknownPolicy};
 use fuzzyvox::sim::scenario::{self, Scenario};
@@ -107,7 +107,7 @@ pub fn experiment_config(
         resolution,
         operators,
         seed,
-        flights: (plan > 0).then(|| FlightConfig {
+        flights: (plan > 0).then(|| QueryConfig {
             queries: plan,
             seed,
             altitude: scenario.flight_altitude,
@@ -116,7 +116,7 @@ pub fn experiment_config(
                 unknown,
                 ..PlannerConfig::default()
             },
-            ..FlightConfig::default()
+            ..QueryConfig::default()
         }),
         sample_pairs,
         ..ExperimentConfig::default()

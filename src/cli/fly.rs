@@ -3,7 +3,10 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
-use fuzzyvox::fly::{FlyConfig, FlyModel, draw_goals, flights_json, fly_all, write_flight_figures};
+use fuzzyvox::MapKind;
+use fuzzyvox::eval::QueryConfig;
+use fuzzyvox::eval::closed_loop::{ClosedLoopReport, draw_goals, fly_all, write_flight_figures};
+use fuzzyvox::fly::FlyConfig;
 use fuzzyvox::plan::UnknownPolicy;
 
 use super::eval::ScenarioName;
@@ -99,11 +102,11 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let mut models = Vec::new();
     for m in &args.model {
-        let add: &[FlyModel] = match m {
-            ModelArg::All => &FlyModel::ALL,
-            ModelArg::Fuzzy => &[FlyModel::Fuzzy],
-            ModelArg::Logodds => &[FlyModel::LogOdds],
-            ModelArg::Alpha => &[FlyModel::Alpha],
+        let add: &[MapKind] = match m {
+            ModelArg::All => &MapKind::ALL,
+            ModelArg::Fuzzy => &[MapKind::Fuzzy],
+            ModelArg::Logodds => &[MapKind::LogOdds],
+            ModelArg::Alpha => &[MapKind::AlphaCut],
         };
         for model in add {
             if !models.contains(model) {
@@ -140,7 +143,8 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
         bail!("--out {} exists and is not a folder", out.display());
     }
     let scenario = args.scenario.build(2, args.seed)?;
-    let goals = draw_goals(&scenario, &config, args.goals, args.seed)?;
+    let queries = QueryConfig::closed_loop(args.goals, args.seed, config.planner);
+    let goals = draw_goals(&scenario, &config, &queries)?;
     if goals.is_empty() {
         bail!(
             "no start and goal could be drawn in the {} scenario",
@@ -160,10 +164,10 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
     )?;
     bar.finish_and_clear();
 
-    let mut report = flights_json(&goals, &config, &flights);
-    report["scenario"] = scenario.name.into();
-    report["seed"] = args.seed.into();
-    report["seconds"] = started.elapsed().as_secs_f64().into();
+    let mut report = ClosedLoopReport::new(&goals, &config, &queries, &flights);
+    report.scenario = Some(scenario.name.to_string());
+    report.seed = Some(args.seed);
+    report.seconds = Some(started.elapsed().as_secs_f64());
     if let Some(out) = &args.out {
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
         let file = out.join("fly.json");
@@ -173,7 +177,7 @@ pub fn run(args: FlyArgs) -> anyhow::Result<()> {
         })?;
     }
     if args.json {
-        return super::print_json(&report);
+        return super::print_json(&serde_json::to_value(&report)?);
     }
     println!(
         "{} scenario, seed {}: {} flights per map ({:.0} s)",

@@ -3,7 +3,7 @@
 
 use super::depth_stage::DepthStageErrors;
 use super::experiment::{DepthSample, ExperimentReport};
-use crate::figure::chart::{BarPanel, Chart, LinePanel, Panel};
+use fuzzyvox_figure::chart::{BarPanel, Chart, LinePanel, Panel};
 
 /// Holes, spurious voxels, occupied F1 and flight success of the three models (`logodds`,
 /// `alpha`, `fuzzy`, in that order, those the experiment built).

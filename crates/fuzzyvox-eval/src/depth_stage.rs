@@ -9,7 +9,7 @@ use nalgebra::Point3;
 use serde::Serialize;
 
 use super::rgbd::median;
-use crate::integrate::{DepthFrame, IntervalDepthImage};
+use fuzzyvox_core::integrate::{DepthFrame, IntervalDepthImage};
 
 /// One compared pixel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,7 +179,7 @@ fn figures(compared: &[Comparison]) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::PinholeIntrinsics;
+    use fuzzyvox_core::geometry::PinholeIntrinsics;
     use nalgebra::{Isometry3, Translation3};
 
     fn frame(depth: f32, near: f32, far: f32, confidence: f32, x: f64) -> DepthFrame {

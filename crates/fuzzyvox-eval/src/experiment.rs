@@ -1,7 +1,7 @@
 //! The experiment runner: one scenario, identical depth-stage output fed to every map, metrics
 //! after every phase.
 
-use crate::map::VoxelMapMut;
+use fuzzyvox_core::map::VoxelMapMut;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -10,19 +10,20 @@ use nalgebra::Isometry3;
 use serde::Serialize;
 
 use super::flights::{
-    FlightConfig, FlightOutcome, FlightQuery, FlightSummary, flight_queries, fly, summarize,
+    Candidates, FlightOutcome, FlightQuery, FlightSummary, QueryConfig, draw_queries, plan_queries,
+    summarize,
 };
 use super::metrics::{MapMetrics, evaluate};
 use super::truth::{GroundTruth, gold_standard};
-use crate::depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
-use crate::error::{Error, Result};
-use crate::integrate::{DepthFrame, EvidenceModel, IntegrationOptions, IntervalDepthImage};
-use crate::map::{
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::integrate::{DepthFrame, EvidenceModel, IntegrationOptions, IntervalDepthImage};
+use fuzzyvox_core::map::{
     AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
 };
-use crate::ops::{Family, TConorm};
-use crate::sim::scenario::Scenario;
-use crate::sim::{RenderedFrame, render};
+use fuzzyvox_core::ops::{Family, TConorm};
+use fuzzyvox_depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
+use fuzzyvox_sim::scenario::Scenario;
+use fuzzyvox_sim::{RenderedFrame, render};
 
 /// Settings of an experiment.
 #[derive(Clone, Debug)]
@@ -45,17 +46,17 @@ pub struct ExperimentConfig {
     /// Seed of the sensor noise.
     pub seed: u64,
     /// Planned flights checked against the true scene after the last phase; `None`: none.
-    pub flights: Option<FlightConfig>,
+    pub flights: Option<QueryConfig>,
     /// Pairs (by index) whose depth-stage output is kept for figures.
     pub sample_pairs: Vec<usize>,
     /// Camera views behind each depth image. 2 (the default, the paper's depth stage): each
     /// pair on its own. `N > 2`: each pair's two views and the `N - 2` most recent earlier
     /// camera positions of the same phase, matched at once by a multiple-baseline plane sweep
-    /// ([`depth_from_views`](crate::depth::depth_from_views)); a phase's first pair, with no
+    /// ([`depth_from_views`](fuzzyvox_depth::depth_from_views)); a phase's first pair, with no
     /// earlier views, is matched on its own. At most 17.
     pub views: usize,
     /// Whether each depth image's confidence is scaled by its
-    /// [`reuse_weight`](crate::depth::DepthResult::reuse_weight) (`2 / views`) before it goes to
+    /// [`reuse_weight`](fuzzyvox_depth::DepthResult::reuse_weight) (`2 / views`) before it goes to
     /// the maps, so that images sharing views are not counted as independent evidence. Changes
     /// nothing for pairs; default `true`. The log-odds map ignores confidence either way.
     pub weigh_reused_views: bool,
@@ -393,15 +394,19 @@ pub fn run_experiment_with_progress(
             let t = Instant::now();
             // Flights are drawn from, and planned in, what the cameras could know of the truth.
             let truth_map = camera_truth.as_ref().unwrap_or(&gold);
-            let queries = flight_queries(&scenario.scene, truth_map, flight_config)?;
+            let queries = draw_queries(
+                &scenario.scene,
+                Candidates::Reference(truth_map),
+                flight_config,
+            )?;
             let mut flights = vec![(
                 "truth".to_string(),
-                fly(truth_map, &scenario.scene, &queries, &flight_config.planner),
+                plan_queries(truth_map, &scenario.scene, &queries, &flight_config.planner),
             )];
             for (name, map) in &maps {
                 flights.push((
                     name.clone(),
-                    fly(
+                    plan_queries(
                         map.as_map(),
                         &scenario.scene,
                         &queries,

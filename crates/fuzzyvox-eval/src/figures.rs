@@ -1,4 +1,4 @@
-//! The report's figures, drawn with [`crate::figure`]: top-down views of the occupied voxels
+//! The report's figures, drawn with [`fuzzyvox_figure`]: top-down views of the occupied voxels
 //! (with or without free space), planned flights over a map, and the depth stage's images of
 //! one pair, each with its title, axes in metres, scale bar and legend.
 
@@ -7,12 +7,12 @@ use std::path::Path;
 use nalgebra::Point3;
 
 use super::experiment::DepthSample;
-use crate::error::{Error, Result};
-use crate::figure::palette::{PATH_COLLIDES, PATH_OK};
-use crate::figure::{
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_figure::palette::{PATH_COLLIDES, PATH_OK};
+use fuzzyvox_figure::{
     ImagePanel, Overlay, View, ViewColor, ViewSpec, image_figure, save_png, view_figure,
 };
-use crate::map::VoxelMap;
 
 /// The part of the world a top-down view shows: the x/y box `[min, max]` (metres) and the
 /// heights `[low, high]` that the colour map spans; voxels whose centre lies below `low` (the

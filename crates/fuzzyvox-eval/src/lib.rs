@@ -28,15 +28,8 @@
     )
 )]
 
-use fuzzyvox_core::{error, geometry, integrate, map, measures, ops, storage};
-use fuzzyvox_depth as depth;
-use fuzzyvox_figure as figure;
-use fuzzyvox_io as io;
-use fuzzyvox_plan as plan;
-use fuzzyvox_sim as sim;
-use fuzzyvox_view as view;
-
 mod charts;
+pub mod closed_loop;
 mod depth_stage;
 mod experiment;
 mod figures;
@@ -54,8 +47,9 @@ pub use experiment::{
 };
 pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
 pub use flights::{
-    BlockedByCounts, BlockingClass, FailureCounts, FlightConfig, FlightFailure, FlightOutcome,
-    FlightQuery, FlightSummary, flight_queries, fly, summarize,
+    BlockedByCounts, BlockingClass, Candidates, Connect, FailureCounts, FlightFailure,
+    FlightOutcome, FlightQuery, FlightSummary, Obstacles, QueryConfig, draw_queries, path_collides,
+    plan_queries, summarize,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};

@@ -2,9 +2,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::truth::{GroundTruth, meets_geometry};
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-use crate::sim::Scene;
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
+use fuzzyvox_sim::Scene;
 
 /// How one map compares with the ground truth.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -94,10 +94,10 @@ fn ratio(part: usize, whole: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::{Evidence, ScanEvidence};
-    use crate::map::{FuzzyConfig, FuzzyMap};
-    use crate::sim::SurfaceKind;
-    use crate::storage::{Resolution, VoxelKey};
+    use fuzzyvox_core::integrate::{Evidence, ScanEvidence};
+    use fuzzyvox_core::map::{FuzzyConfig, FuzzyMap};
+    use fuzzyvox_core::storage::{Resolution, VoxelKey};
+    use fuzzyvox_sim::SurfaceKind;
     use nalgebra::{Point3, Vector3};
 
     #[test]

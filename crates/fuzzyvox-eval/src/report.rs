@@ -8,9 +8,9 @@ use super::charts::{depth_confidence_chart, maps_chart, operators_chart};
 use super::experiment::{ExperimentOutput, ExperimentReport};
 use super::figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
 use super::metrics::MapMetrics;
-use crate::error::Result;
-use crate::sim::scenario::Scenario;
-use crate::view::{PagePath, PathKind, ViewerOptions, write_viewer_page};
+use fuzzyvox_core::error::Result;
+use fuzzyvox_sim::scenario::Scenario;
+use fuzzyvox_view::{PagePath, PathKind, ViewerOptions, write_viewer_page};
 
 /// Free (and unknown) voxels written to each map's viewer page at most.
 const PAGE_MAX_FREE: usize = 150_000;
@@ -118,12 +118,12 @@ pub fn write_experiment(
         }
         let json = dir.join(format!("{stem}-paths.json"));
         let text = serde_json::to_string(&serde_json::json!({ "paths": paths })).map_err(|e| {
-            crate::error::Error::Io {
+            fuzzyvox_core::error::Error::Io {
                 path: json.clone(),
                 source: std::io::Error::other(e),
             }
         })?;
-        crate::io::write_atomic(&json, text.as_bytes())?;
+        fuzzyvox_io::write_atomic(&json, text.as_bytes())?;
         files.push(json);
         let mut options = ViewerOptions::new(
             format!("{name} scenario, {map_name} map"),
@@ -351,7 +351,7 @@ pub fn report_html(title: &str, markdown: &str) -> String {
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
          <title>{}</title>\n<style>{REPORT_CSS}</style>\n</head>\n<body>\n<main>\n{body}</main>\n\
          </body>\n</html>\n",
-        crate::view::escape_html(title)
+        fuzzyvox_view::escape_html(title)
     )
 }
 

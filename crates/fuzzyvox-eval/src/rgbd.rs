@@ -8,10 +8,10 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result, finite};
-use crate::integrate::DepthFrame;
-use crate::map::{VoxelMap, cast_ray};
-use crate::measures::VoxelClass;
+use fuzzyvox_core::error::{Error, Result, finite};
+use fuzzyvox_core::integrate::DepthFrame;
+use fuzzyvox_core::map::{VoxelMap, cast_ray};
+use fuzzyvox_core::measures::VoxelClass;
 
 /// Which frames build the map and which are held out: every `every`-th frame (the 5th, 10th,
 /// ... for `every = 5`) is held out, the others build.
@@ -238,11 +238,11 @@ pub struct DepthAgreement {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::{IntegrationOptions, IntervalDepthImage};
-    use crate::io::rgbd::kinect_interval_image;
-    use crate::map::VoxelMapMut;
-    use crate::map::{FuzzyConfig, FuzzyMap};
+    use fuzzyvox_core::integrate::{IntegrationOptions, IntervalDepthImage};
+    use fuzzyvox_core::map::VoxelMapMut;
+    use fuzzyvox_core::map::{FuzzyConfig, FuzzyMap};
     use fuzzyvox_core::{DepthFrame, PinholeIntrinsics};
+    use fuzzyvox_io::rgbd::kinect_interval_image;
     use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
     /// A camera at `x` metres left of the origin looking along +z at a wall at z = 2 m.
@@ -255,7 +255,7 @@ mod tests {
         let k = PinholeIntrinsics::new(64, 48, 50.0, 50.0, 31.5, 23.5).unwrap();
         let pose =
             Isometry3::from_parts(Translation3::new(x, 0.0, 0.0), UnitQuaternion::identity());
-        let depth = crate::io::rgbd::DepthImage {
+        let depth = fuzzyvox_io::rgbd::DepthImage {
             width: 64,
             height: 48,
             depth: vec![depth; 64 * 48],

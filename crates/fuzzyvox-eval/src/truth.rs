@@ -1,14 +1,14 @@
-use crate::map::VoxelMapMut;
+use fuzzyvox_core::map::VoxelMapMut;
 use nalgebra::Isometry3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
 
-use crate::error::Result;
-use crate::geometry::PinholeIntrinsics;
-use crate::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
-use crate::map::{LogOddsConfig, LogOddsMap, VoxelMap};
-use crate::sim::{Scene, render};
-use crate::storage::{Resolution, VoxelKey};
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::geometry::PinholeIntrinsics;
+use fuzzyvox_core::integrate::{DepthFrame, IntegrationOptions, IntervalDepthImage};
+use fuzzyvox_core::map::{LogOddsConfig, LogOddsMap, VoxelMap};
+use fuzzyvox_core::storage::{Resolution, VoxelKey};
+use fuzzyvox_sim::{Scene, render};
 
 /// What is really there, voxel by voxel, within what the cameras could see.
 #[derive(Clone, Debug)]

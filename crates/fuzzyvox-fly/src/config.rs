@@ -2,8 +2,8 @@
 
 use serde::Serialize;
 
-use crate::error::{Error, Result};
-use crate::plan::{PlannerConfig, UnknownPolicy};
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_plan::{PlannerConfig, UnknownPolicy};
 
 /// Every setting of a closed-loop flight, in one value.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -91,14 +91,6 @@ pub struct FlyConfig {
     pub blind_steps: bool,
     /// Horizontal margin of the planning region around start and goal, metres. Default 6.
     pub region_margin: f64,
-    /// Lowest and highest altitude of starts and goals, metres. Default 1.5 to 6.
-    pub altitude: (f64, f64),
-    /// Shortest and longest straight-line distance between start and goal, metres. Default 8
-    /// to 20.
-    pub distance: (f64, f64),
-    /// Extra distance beyond the vehicle radius that starts and goals keep from every true
-    /// surface, metres. Default 0.5.
-    pub surface_margin: f64,
 }
 
 impl Default for FlyConfig {
@@ -129,9 +121,6 @@ impl Default for FlyConfig {
             leaning_occupied: 0.2,
             blind_steps: false,
             region_margin: 6.0,
-            altitude: (1.5, 6.0),
-            distance: (8.0, 20.0),
-            surface_margin: 0.5,
         }
     }
 }
@@ -164,7 +153,6 @@ impl FlyConfig {
         for (name, value) in [
             ("unknown guard", self.unknown_guard),
             ("guard surface reach", self.guard_surface_reach),
-            ("surface margin", self.surface_margin),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(Error::InvalidParameter {
@@ -206,15 +194,6 @@ impl FlyConfig {
                 value: 0.0,
                 expected: "at least 1 frame",
             });
-        }
-        for (name, (lo, hi)) in [("altitude", self.altitude), ("distance", self.distance)] {
-            if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
-                return Err(Error::InvalidParameter {
-                    name,
-                    value: lo,
-                    expected: "a range 0 <= low < high, finite",
-                });
-            }
         }
         if !(2..=17).contains(&self.views) {
             return Err(Error::InvalidParameter {

@@ -25,9 +25,9 @@
 use nalgebra::Point3;
 use rustc_hash::FxHashSet;
 
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-use crate::plan::CostField;
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
+use fuzzyvox_plan::CostField;
 
 /// The suspect voxels of one flight and the voxels they forbid, over the field's region.
 #[derive(Clone, Debug, Default)]
@@ -224,10 +224,10 @@ fn squared(a: [i64; 3], b: [i64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::map::FunctionMap;
-    use crate::measures::Memberships;
-    use crate::plan::{PlannerConfig, PlanningRegion, UnknownPolicy};
-    use crate::storage::{Resolution, VoxelKey};
+    use fuzzyvox_core::map::FunctionMap;
+    use fuzzyvox_core::measures::Memberships;
+    use fuzzyvox_core::storage::{Resolution, VoxelKey};
+    use fuzzyvox_plan::{PlannerConfig, PlanningRegion, UnknownPolicy};
 
     /// A 6 × 6 × 2 m box at 0.2 m: free everywhere, but a wall at x = 15 (occupied for
     /// y < 15, unknown beyond: the part not seen yet) and a patch of unknown space far from

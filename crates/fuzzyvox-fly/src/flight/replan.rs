@@ -1,0 +1,108 @@
+//! Planning from where the vehicle is: A* through the cost field, or towards the reachable
+//! voxel nearest the goal when the goal cannot be reached yet.
+
+use fuzzyvox_core::storage::VoxelKey;
+use fuzzyvox_plan::{CostField, PlanError, plan_in_field_avoiding};
+use nalgebra::Point3;
+
+/// Plans through `field` from `position` to the goal. When the voxel the vehicle is in cannot
+/// be entered (the map learnt that something is near), plans from the nearest traversable
+/// voxel within half a metre instead. Never enters a voxel `avoid` names (the start
+/// excepted).
+pub(super) fn replan(
+    field: &CostField,
+    position: Point3<f64>,
+    goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
+) -> std::result::Result<Vec<Point3<f64>>, PlanError> {
+    let resolution = field.resolution();
+    let region = *field.region();
+    let here = resolution.key_of(&position)?;
+    let start = match region.index_of(here) {
+        Some(index) if !field.is_traversable(index) => {
+            let reach = (0.5 / resolution.size()).ceil() as i32;
+            let mut best: Option<(i32, VoxelKey)> = None;
+            for dz in -reach..=reach {
+                for dy in -reach..=reach {
+                    for dx in -reach..=reach {
+                        let key = VoxelKey::new(here.x + dx, here.y + dy, here.z + dz);
+                        let d2 = dx * dx + dy * dy + dz * dz;
+                        if best.is_none_or(|(b, _)| d2 < b)
+                            && region
+                                .index_of(key)
+                                .is_some_and(|i| field.is_traversable(i) && !avoid(i))
+                        {
+                            best = Some((d2, key));
+                        }
+                    }
+                }
+            }
+            best.map_or(here, |(_, key)| key)
+        }
+        _ => here,
+    };
+    let mut path = match plan_in_field_avoiding(field, start, goal, avoid) {
+        // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
+        // it (the known-safe frontier towards the goal), see more, and plan again there.
+        Err(PlanError::GoalUnsafe(_) | PlanError::GoalAvoided | PlanError::Disconnected { .. }) => {
+            let target = nearest_reachable(field, start, goal, avoid)
+                .ok_or(PlanError::Disconnected { expanded: 0 })?;
+            if resolution.center(target) == resolution.center(start) {
+                return Err(PlanError::Disconnected { expanded: 0 });
+            }
+            plan_in_field_avoiding(field, start, target, avoid)?
+        }
+        other => other?,
+    };
+    // The path starts where the vehicle is, not at its voxel's centre.
+    if let Some(first) = path.waypoints.first_mut() {
+        *first = position;
+    }
+    Ok(path.waypoints)
+}
+
+/// The traversable voxel connected to `start` (through the field's 26-neighbourhood) nearest
+/// to `goal` without entering a voxel `avoid` names, ties to the lowest index; `None` when
+/// `start` is not traversable.
+fn nearest_reachable(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
+) -> Option<VoxelKey> {
+    let region = field.region();
+    let first = region
+        .index_of(start)
+        .filter(|&i| field.is_traversable(i))?;
+    let mut seen = vec![false; region.len()];
+    let mut queue = std::collections::VecDeque::from([first]);
+    seen[first] = true;
+    let distance = |key: VoxelKey| {
+        let d = [key.x - goal.x, key.y - goal.y, key.z - goal.z].map(i64::from);
+        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    };
+    let mut best = (distance(start), first);
+    while let Some(index) = queue.pop_front() {
+        let key = region.key_at(index);
+        let d = distance(key);
+        if d < best.0 || (d == best.0 && index < best.1) {
+            best = (d, index);
+        }
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let next = VoxelKey::new(key.x + dx, key.y + dy, key.z + dz);
+                    if let Some(n) = region.index_of(next)
+                        && !seen[n]
+                        && field.is_traversable(n)
+                        && !avoid(n)
+                    {
+                        seen[n] = true;
+                        queue.push_back(n);
+                    }
+                }
+            }
+        }
+    }
+    Some(region.key_at(best.1))
+}
