@@ -7,8 +7,8 @@ use nalgebra::{Isometry3, Vector3};
 
 use super::gray::GrayImage;
 use super::quality::{ExtrinsicQuality, extrinsic_quality};
-use crate::error::{Error, Result};
-use crate::geometry::{PinholeIntrinsics, validate_pose};
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::geometry::{PinholeIntrinsics, validate_pose};
 
 /// One posed image of the stream.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,7 +29,7 @@ impl Frame {
         timestamp: f64,
     ) -> Result<Self> {
         validate_pose(&world_from_camera)?;
-        crate::error::finite("timestamp", timestamp)?;
+        fuzzyvox_core::error::finite("timestamp", timestamp)?;
         if image.width() != intrinsics.width() || image.height() != intrinsics.height() {
             return Err(Error::SizeMismatch {
                 what: "frame image pixels (intrinsics width × height)",

@@ -10,8 +10,8 @@
 
 use super::params::DisparityMap;
 use super::rectify::StereoGeometry;
-use crate::error::{Error, Result};
-use crate::integrate::IntervalDepthImage;
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::integrate::IntervalDepthImage;
 
 /// How `P-` and `P+` are derived from the disparity.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,7 +173,7 @@ pub fn match_reliability(cost: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::PinholeIntrinsics;
+    use fuzzyvox_core::geometry::PinholeIntrinsics;
     use nalgebra::Isometry3;
 
     fn geometry() -> StereoGeometry {

@@ -20,8 +20,6 @@
     )
 )]
 
-use fuzzyvox_core::{error, geometry, integrate};
-
 mod census;
 mod frame;
 mod gray;
@@ -38,12 +36,12 @@ mod sweep;
 mod texture;
 mod views;
 
-pub use crate::error::UnrectifiableReason;
 pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
     census_transform,
 };
 pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
+pub use fuzzyvox_core::error::UnrectifiableReason;
 pub use gray::GrayImage;
 pub use interval::{
     IntervalMethod, IntervalParams, RELIABLE_COST, confidence, interval_image, match_reliability,

@@ -2,7 +2,7 @@
 //! reference table: errors count over pixels with ground truth; "matched" figures judge only
 //! pixels that got a disparity, "all" figures count a pixel without one as an error.
 
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
 
 /// Accuracy figures, in percent.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]

@@ -1,6 +1,6 @@
 //! The matcher's parameters and its result.
 
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
 
 /// Largest supported aggregation window side; keeps window sums inside `i16`.
 pub const MAX_WINDOW: u32 = 15;

@@ -11,9 +11,9 @@ use super::params::{DisparityMap, MatchParams};
 use super::quality::extrinsic_quality;
 use super::rectify::{Rectification, Side, StereoGeometry, epipole_within};
 use super::sweep::{Sweep, sweep_views};
-use crate::error::UnrectifiableReason;
-use crate::error::{Error, Result};
-use crate::integrate::DepthFrame;
+use fuzzyvox_core::error::UnrectifiableReason;
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::integrate::DepthFrame;
 
 /// Settings of the whole depth stage.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -84,7 +84,7 @@ impl DepthResult {
     /// sharing most of their views, repeat each other's errors. An aggregation that treats
     /// observations as independent (the probabilistic sum) would count those errors `N / 2`
     /// times as often as with pairs. Scaling the image's confidence by this weight
-    /// ([`DepthFrame::scale_confidence`](crate::integrate::DepthFrame::scale_confidence))
+    /// ([`DepthFrame::scale_confidence`](fuzzyvox_core::integrate::DepthFrame::scale_confidence))
     /// keeps every position's total weight what the paper's pairs give it.
     pub fn reuse_weight(&self) -> f32 {
         2.0 / self.views.max(2) as f32

@@ -12,8 +12,8 @@
 
 use nalgebra::{Isometry3, Vector3};
 
-use crate::error::Result;
-use crate::geometry::validate_pose;
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::geometry::validate_pose;
 
 /// The terms of `Q_ABD` for one pair.
 #[derive(Clone, Copy, Debug, PartialEq)]

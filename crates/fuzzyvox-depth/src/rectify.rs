@@ -8,8 +8,8 @@ use nalgebra::{Isometry3, Matrix3, Point2, Rotation3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
 use super::gray::GrayImage;
-use crate::error::{Error, Result, UnrectifiableReason};
-use crate::geometry::{PinholeIntrinsics, validate_pose};
+use fuzzyvox_core::error::{Error, Result, UnrectifiableReason};
+use fuzzyvox_core::geometry::{PinholeIntrinsics, validate_pose};
 
 /// Camera centres closer than this (metres) count as the same point.
 pub const MIN_BASELINE: f64 = 1e-9;
@@ -38,7 +38,7 @@ impl StereoGeometry {
         doffs: f64,
     ) -> Result<Self> {
         validate_pose(&world_from_reference)?;
-        crate::error::finite("doffs", doffs)?;
+        fuzzyvox_core::error::finite("doffs", doffs)?;
         if !(baseline.is_finite() && baseline > MIN_BASELINE) {
             return Err(Error::Unrectifiable {
                 reason: UnrectifiableReason::ZeroBaseline { baseline },

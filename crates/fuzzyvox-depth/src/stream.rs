@@ -10,7 +10,7 @@ use super::{
     DepthParams, DepthResult, ForwardMotion, Frame, MatchMethod, PairCriteria, PairSelector,
     ViewWindow,
 };
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
 
 /// Why a frame of the stream gave no depth image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

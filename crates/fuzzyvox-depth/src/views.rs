@@ -4,7 +4,7 @@
 use super::frame::Frame;
 use super::pipeline::{DepthParams, DepthResult, depth_from_pair, depth_from_views};
 use super::sweep::{MAX_SWEEP_VIEWS, PLANE_COUNT};
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
 
 /// Camera positions closer than this (metres) count as one and add no baseline.
 const SAME_POSITION: f64 = 1e-6;
@@ -134,8 +134,8 @@ impl ViewWindow {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::PinholeIntrinsics;
     use crate::{ForwardMotion, GrayImage};
+    use fuzzyvox_core::geometry::PinholeIntrinsics;
     use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
     /// A frame at `x` on a line, looking along +z at a striped plane 5 m away.

@@ -3,9 +3,9 @@ use std::fmt;
 use nalgebra::Point3;
 use serde::{Serialize, Serializer};
 
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-use crate::storage::{KeyBox, Resolution, VoxelKey};
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
+use fuzzyvox_core::storage::{KeyBox, Resolution, VoxelKey};
 
 /// Why the planner may not enter the voxel of a start or goal, with the numbers a user needs
 /// to change the request: the class of the voxel, its safety, or its clearance and the blocked
@@ -91,7 +91,7 @@ pub struct ObservedExtent {
 
 impl ObservedExtent {
     /// The extent of `map`'s observed voxels, or `None` when the map lists none (an empty map,
-    /// or one such as [`FunctionMap`](crate::map::FunctionMap) that has no stored voxels).
+    /// or one such as [`FunctionMap`](fuzzyvox_core::map::FunctionMap) that has no stored voxels).
     ///
     /// Visits every stored voxel, so it costs about as much as `fuzzyvox info`.
     pub fn of(map: &dyn VoxelMap) -> Option<Self> {
@@ -262,11 +262,12 @@ fn class_name<S: Serializer>(class: &VoxelClass, serializer: S) -> Result<S::Ok,
 
 #[cfg(test)]
 mod tests {
+    use fuzzyvox_core::integrate::{IntegrationOptions, PointCloud};
+    use fuzzyvox_core::map::VoxelMapMut;
+    use fuzzyvox_core::map::{FunctionMap, FuzzyConfig, FuzzyMap};
+    use fuzzyvox_core::measures::Memberships;
+
     use super::*;
-    use crate::integrate::{IntegrationOptions, PointCloud};
-    use crate::map::VoxelMapMut;
-    use crate::map::{FunctionMap, FuzzyConfig, FuzzyMap};
-    use crate::measures::Memberships;
     use crate::{PlanError, PlannerConfig, UnknownPolicy, plan_path};
 
     /// A 6 × 6 × 3 m box of confident free space (unknown outside) at 0.1 m with one voxel of

@@ -1,6 +1,6 @@
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result, finite};
+use fuzzyvox_core::error::{Error, Result, finite};
 
 /// What to do with space the map knows nothing about.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

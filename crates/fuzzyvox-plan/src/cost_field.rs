@@ -1,116 +1,19 @@
-use nalgebra::Point3;
+//! The cost field: a planning region of a map turned into what a planner needs per voxel,
+//! built in full from any map (kept current by [`CostField::update`]).
 
-use super::blocker::{Blocker, NearestBlocked};
-use super::config::{PlannerConfig, UnknownPolicy};
-use super::edt::squared_distance_transform;
-use super::field_update::block_parts;
-use super::least_rate::LeastRate;
-use crate::error::{Error, Result};
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-use crate::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
+use fuzzyvox_core::storage::{BLOCK_CELLS, BlockKey, Resolution, VoxelKey};
+use rayon::prelude::*;
 
-/// Largest planning region, in voxels (a guard against absurd requests: 64 Mi voxels use about
-/// 1.5 GiB of working memory, 24 bytes a voxel with the map's stamps).
-const MAX_REGION_VOXELS: usize = 1 << 26;
-
-/// An axis-aligned box of voxels to plan in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PlanningRegion {
-    min: VoxelKey,
-    dims: [usize; 3],
-}
-
-impl PlanningRegion {
-    /// The voxels from `a` to `b` (inclusive, in any order); at most 2^26 voxels.
-    pub fn new(a: VoxelKey, b: VoxelKey) -> Result<Self> {
-        let min = VoxelKey::new(a.x.min(b.x), a.y.min(b.y), a.z.min(b.z));
-        let span = |lo: i32, hi: i32| (i64::from(hi) - i64::from(lo) + 1) as usize;
-        let dims = [
-            span(min.x, a.x.max(b.x)),
-            span(min.y, a.y.max(b.y)),
-            span(min.z, a.z.max(b.z)),
-        ];
-        let voxels = dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]);
-        if voxels > MAX_REGION_VOXELS {
-            return Err(Error::InvalidParameter {
-                name: "planning region voxels",
-                value: voxels as f64,
-                expected: "a region of at most 2^26 voxels; plan between nearer points or at a coarser resolution",
-            });
-        }
-        Ok(Self { min, dims })
-    }
-
-    /// The box around two points grown by `margin` metres on every side.
-    pub fn around(
-        resolution: &Resolution,
-        a: &Point3<f64>,
-        b: &Point3<f64>,
-        margin: f64,
-    ) -> Result<Self> {
-        let lo = a.inf(b) - nalgebra::Vector3::repeat(margin);
-        let hi = a.sup(b) + nalgebra::Vector3::repeat(margin);
-        Self::new(resolution.key_of(&lo)?, resolution.key_of(&hi)?)
-    }
-
-    /// Size in voxels along x, y, z.
-    pub fn dims(&self) -> [usize; 3] {
-        self.dims
-    }
-
-    /// The lowest key.
-    pub fn min(&self) -> VoxelKey {
-        self.min
-    }
-
-    /// Number of voxels.
-    pub fn len(&self) -> usize {
-        self.dims[0] * self.dims[1] * self.dims[2]
-    }
-
-    /// Whether the region holds no voxel (never, for a constructed region).
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The dense index of `key` (x fastest), if inside.
-    #[inline]
-    pub fn index_of(&self, key: VoxelKey) -> Option<usize> {
-        let x = i64::from(key.x) - i64::from(self.min.x);
-        let y = i64::from(key.y) - i64::from(self.min.y);
-        let z = i64::from(key.z) - i64::from(self.min.z);
-        let [nx, ny, nz] = self.dims.map(|d| d as i64);
-        (x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < nz)
-            .then(|| (x + nx * (y + ny * z)) as usize)
-    }
-
-    /// The dense index of the voxel at region coordinates `[x, y, z]` (each from 0 to its
-    /// dimension, unchecked).
-    #[inline]
-    pub fn index_at(&self, [x, y, z]: [i64; 3]) -> usize {
-        let [nx, ny, _] = self.dims.map(|d| d as i64);
-        (x + nx * (y + ny * z)) as usize
-    }
-
-    /// The region coordinates `[x, y, z]` of a dense index.
-    #[inline]
-    pub fn coordinates_at(&self, index: usize) -> [i64; 3] {
-        let [nx, ny, _] = self.dims;
-        [index % nx, (index / nx) % ny, index / (nx * ny)].map(|c| c as i64)
-    }
-
-    /// The key at a dense index.
-    #[inline]
-    pub fn key_at(&self, index: usize) -> VoxelKey {
-        let [nx, ny, _] = self.dims;
-        VoxelKey::new(
-            self.min.x + (index % nx) as i32,
-            self.min.y + ((index / nx) % ny) as i32,
-            self.min.z + (index / (nx * ny)) as i32,
-        )
-    }
-}
+use crate::blocker::{Blocker, NearestBlocked};
+use crate::config::PlannerConfig;
+use crate::edt::squared_distance_transform;
+use crate::layers::{Scratch, VoxelBox, block_parts, layers};
+use crate::least_rate::LeastRate;
+use crate::region::PlanningRegion;
+use crate::rules::{Rules, Voxel, is_blocked};
 
 /// A map region turned into what a planner needs per voxel: whether it may be entered, its
 /// safety, its clearance, and the cost of moving through it.
@@ -126,7 +29,7 @@ impl PlanningRegion {
 ///   every point of a path whose steps join traversable voxels (or whose straight segments only
 ///   cross traversable voxels) keeps the vehicle radius from every blocked voxel.
 /// - Entering a voxel costs, per metre, `1 + k (1 - S) + w max(0, 1 - clearance / preferred)`
-///   (plus the unknown cost for unknown voxels under [`UnknownPolicy::Cost`]); a step of length
+///   (plus the unknown cost for unknown voxels under [`UnknownPolicy::Cost`](crate::UnknownPolicy::Cost)); a step of length
 ///   `l` between voxels costs `l` times the mean of their two rates, never less than `l`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CostField {
@@ -141,65 +44,6 @@ pub struct CostField {
     pub(super) stamps: Option<Vec<u64>>,
     /// The least rate of any voxel, kept as voxels change.
     pub(super) least: LeastRate,
-}
-
-/// What the field knows of one voxel.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Voxel {
-    pub(super) safety: f32,
-    pub(super) clearance: f32,
-    /// Cost per metre (infinite when not traversable).
-    pub(super) rate: f32,
-    pub(super) class: VoxelClass,
-    pub(super) traversable: bool,
-}
-
-/// The rules that turn a voxel's class, safety and clearance into whether it is blocked or
-/// traversable and what it costs, with the configuration's derived figures computed once.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Rules {
-    config: PlannerConfig,
-    /// [`CostField::required_clearance`].
-    required: f32,
-    /// The preferred clearance (never 0).
-    preferred: f32,
-}
-
-impl Rules {
-    /// Whether a voxel of this class and safety is blocked ([`is_blocked`]).
-    #[inline]
-    pub(super) fn blocked(&self, class: VoxelClass, safety: f32) -> bool {
-        is_blocked(class, safety, &self.config)
-    }
-
-    /// Whether a voxel of this class, safety and clearance is traversable, and its rate.
-    #[inline]
-    pub(super) fn entry(&self, class: VoxelClass, safety: f32, clearance: f32) -> (bool, f32) {
-        let config = &self.config;
-        let traversable = !self.blocked(class, safety) && clearance >= self.required;
-        let rate = if traversable {
-            let unknown = match (class, config.unknown) {
-                (VoxelClass::Unknown, UnknownPolicy::Cost(c)) => c,
-                _ => 0.0,
-            };
-            1.0 + config.safety_weight * (1.0 - safety)
-                + config.clearance_weight * (1.0 - clearance / self.preferred).max(0.0)
-                + unknown
-        } else {
-            f32::INFINITY
-        };
-        (traversable, rate)
-    }
-}
-
-impl Voxel {
-    const UNKNOWN: Self = Self {
-        safety: 0.0,
-        clearance: 0.0,
-        rate: f32::INFINITY,
-        class: VoxelClass::Unknown,
-        traversable: false,
-    };
 }
 
 impl CostField {
@@ -313,13 +157,25 @@ impl CostField {
         (self.voxels[i].traversable, self.voxels[i].rate) = (traversable, rate);
     }
 
+    /// Reads the class, safety and stamp of every voxel of `parts` (blocks sorted by
+    /// [`block_parts`]) into the field, in place and in parallel by layers of blocks; the rest
+    /// of each voxel's entries are left for the caller to derive.
+    fn fill(&mut self, map: &dyn VoxelMap, parts: &[(BlockKey, VoxelBox)]) {
+        let (region, measures) = (*self.region(), *map.measure_config());
+        layers(&region, &mut self.voxels, self.stamps.as_deref_mut(), parts)
+            .into_par_iter()
+            .for_each_init(Scratch::new, |scratch, layer| {
+                layer.fill(map, &region, &measures, scratch)
+            });
+    }
+
     /// The rules that give a voxel's traversability and rate.
     pub(super) fn rules(&self) -> Rules {
-        Rules {
-            config: self.config,
-            required: self.required_clearance() as f32,
-            preferred: self.config.preferred_clearance.max(1e-9) as f32,
-        }
+        Rules::new(
+            self.config,
+            self.required_clearance() as f32,
+            self.config.preferred_clearance.max(1e-9) as f32,
+        )
     }
 
     /// Finds the least rate again by scanning every voxel.
@@ -473,15 +329,5 @@ impl CostField {
     /// Number of traversable voxels.
     pub fn traversable_count(&self) -> usize {
         self.voxels.iter().filter(|v| v.traversable).count()
-    }
-}
-
-/// Whether a voxel of `class` and `safety` is blocked under `config` (occupied, ambiguous, free
-/// with safety below the threshold, or unknown while unknown space is forbidden).
-pub fn is_blocked(class: VoxelClass, safety: f32, config: &PlannerConfig) -> bool {
-    match class {
-        VoxelClass::Occupied | VoxelClass::Ambiguous => true,
-        VoxelClass::Unknown => !matches!(config.unknown, UnknownPolicy::Cost(_)),
-        VoxelClass::Free => safety < config.safety_threshold,
     }
 }

@@ -5,8 +5,9 @@ use petgraph::visit::{
     NodeIndexable, Visitable,
 };
 
-use super::cost_field::CostField;
-use crate::storage::VoxelKey;
+use fuzzyvox_core::storage::VoxelKey;
+
+use crate::cost_field::CostField;
 
 /// The 26 neighbour offsets with their lengths in voxels.
 pub(crate) const NEIGHBOURS: [([i32; 3], f32); 26] = neighbour_table();

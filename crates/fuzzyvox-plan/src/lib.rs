@@ -35,25 +35,34 @@
     )
 )]
 
-use fuzzyvox_core::{error, integrate, map, measures, storage};
-
 mod astar;
 mod blocker;
 mod config;
 mod cost_field;
 mod edt;
+mod error;
 mod field_update;
 mod graph;
+mod layers;
 mod least_rate;
+mod path;
+mod plan_path;
 mod planner;
 mod queries;
+mod region;
+mod rules;
+mod smooth;
 
-pub use astar::{Path, PlanError, plan_in_field, plan_in_field_avoiding, plan_path};
 pub use blocker::{Blocker, NearestBlocked, ObservedExtent};
 pub use config::{PlannerConfig, UnknownPolicy};
-pub use cost_field::{CostField, PlanningRegion, is_blocked};
+pub use cost_field::CostField;
 pub use edt::squared_distance_transform;
+pub use error::PlanError;
 pub use field_update::FieldUpdate;
 pub use graph::{VoxelEdge, VoxelGraph};
+pub use path::{Path, plan_in_field, plan_in_field_avoiding};
+pub use plan_path::plan_path;
 pub use planner::Planner;
 pub use queries::SafetyQueries;
+pub use region::PlanningRegion;
+pub use rules::is_blocked;

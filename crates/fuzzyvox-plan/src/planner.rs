@@ -1,15 +1,18 @@
 //! A planner that follows a map as it grows: it owns the cost field of a region and updates it
 //! from the blocks each integration changed.
 
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::storage::VoxelKey;
 use nalgebra::Point3;
 
-use super::astar::{Path, PlanError, plan_in_field, segment_voxels};
-use super::config::PlannerConfig;
-use super::cost_field::{CostField, PlanningRegion};
-use super::field_update::FieldUpdate;
-use crate::error::Result;
-use crate::map::VoxelMap;
-use crate::storage::VoxelKey;
+use crate::config::PlannerConfig;
+use crate::cost_field::CostField;
+use crate::error::PlanError;
+use crate::field_update::FieldUpdate;
+use crate::path::{Path, plan_in_field};
+use crate::region::PlanningRegion;
+use crate::smooth::segment_voxels;
 
 /// The cost field of one region of one map, kept current as the map changes.
 ///

@@ -1,10 +1,10 @@
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
+use fuzzyvox_core::storage::{KeyBox, VoxelKey};
 use nalgebra::Point3;
 
-use super::config::{PlannerConfig, UnknownPolicy};
-use crate::error::Result;
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-use crate::storage::{KeyBox, VoxelKey};
+use crate::config::{PlannerConfig, UnknownPolicy};
 
 /// Questions a planner asks of any map, answered with one [`PlannerConfig`].
 ///
