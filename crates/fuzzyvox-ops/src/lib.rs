@@ -55,6 +55,7 @@ mod hedge;
 pub(crate) mod numeric;
 mod tconorm;
 mod tnorm;
+mod validated;
 
 #[cfg(test)]
 mod tests;

@@ -17,6 +17,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::numeric::{logistic, logit, ordered, p_norm, to_unit, unit};
+use super::validated::validated_family;
 use super::{Family, OperatorError, TNorm, frank, generator, tnorm};
 
 /// A validated t-conorm (fuzzy OR, evidence accumulation) of one [`Family`].
@@ -28,28 +29,9 @@ pub struct TConorm {
     family: Family,
 }
 
+validated_family!(TConorm, "t-conorm");
+
 impl TConorm {
-    /// Creates the t-conorm of `family` after validating its parameter.
-    ///
-    /// # Errors
-    /// [`OperatorError::InvalidParameter`] if the parameter is not finite or is
-    /// outside the family's domain.
-    pub fn new(family: Family) -> Result<TConorm, OperatorError> {
-        Ok(TConorm {
-            family: family.validate()?,
-        })
-    }
-
-    /// Wraps a family that is already known to be valid (used by `dual`).
-    pub(crate) fn from_validated(family: Family) -> TConorm {
-        TConorm { family }
-    }
-
-    /// The family this t-conorm belongs to.
-    pub fn family(&self) -> Family {
-        self.family
-    }
-
     /// The dual t-norm `T(x, y) = 1 - S(1 - x, 1 - y)` of the same family.
     pub fn dual(&self) -> TNorm {
         TNorm::from_validated(self.family)
@@ -154,20 +136,6 @@ impl std::fmt::Display for TConorm {
             super::family::write_parameter(f, value)?;
         }
         Ok(())
-    }
-}
-
-impl TryFrom<Family> for TConorm {
-    type Error = OperatorError;
-
-    fn try_from(family: Family) -> Result<TConorm, OperatorError> {
-        TConorm::new(family)
-    }
-}
-
-impl From<TConorm> for Family {
-    fn from(tconorm: TConorm) -> Family {
-        tconorm.family
     }
 }
 

@@ -11,6 +11,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::numeric::{logistic, logit, ordered, p_norm, to_unit, unit};
+use super::validated::validated_family;
 use super::{Family, OperatorError, TConorm, frank};
 
 /// A validated t-norm (fuzzy AND) of one [`Family`].
@@ -22,28 +23,9 @@ pub struct TNorm {
     family: Family,
 }
 
+validated_family!(TNorm, "t-norm");
+
 impl TNorm {
-    /// Creates the t-norm of `family` after validating its parameter.
-    ///
-    /// # Errors
-    /// [`OperatorError::InvalidParameter`] if the parameter is not finite or is
-    /// outside the family's domain.
-    pub fn new(family: Family) -> Result<TNorm, OperatorError> {
-        Ok(TNorm {
-            family: family.validate()?,
-        })
-    }
-
-    /// Wraps a family that is already known to be valid (used by `dual`).
-    pub(crate) fn from_validated(family: Family) -> TNorm {
-        TNorm { family }
-    }
-
-    /// The family this t-norm belongs to.
-    pub fn family(&self) -> Family {
-        self.family
-    }
-
     /// The dual t-conorm `S(x, y) = 1 - T(1 - x, 1 - y)` of the same family.
     pub fn dual(&self) -> TConorm {
         TConorm::from_validated(self.family)
@@ -104,20 +86,6 @@ impl Default for TNorm {
         TNorm {
             family: Family::Minimum,
         }
-    }
-}
-
-impl TryFrom<Family> for TNorm {
-    type Error = OperatorError;
-
-    fn try_from(family: Family) -> Result<TNorm, OperatorError> {
-        TNorm::new(family)
-    }
-}
-
-impl From<TNorm> for Family {
-    fn from(tnorm: TNorm) -> Family {
-        tnorm.family
     }
 }
 
