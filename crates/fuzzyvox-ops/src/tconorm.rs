@@ -20,23 +20,15 @@ use super::numeric::{logistic, logit, ordered, p_norm, to_unit, unit};
 use super::validated::validated_family;
 use super::{Family, OperatorError, TNorm, frank, generator, tnorm};
 
-/// A validated t-conorm (fuzzy OR, evidence accumulation) of one [`Family`].
-///
-/// Serialises as its [`Family`]; deserialising validates the parameter.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "Family", into = "Family")]
-pub struct TConorm {
-    family: Family,
-}
-
-validated_family!(TConorm, "t-conorm");
+validated_family!(
+    /// A validated t-conorm (fuzzy OR, evidence accumulation) of one [`Family`].
+    TConorm,
+    "t-conorm",
+    dual: TNorm,
+    "The dual t-norm `T(x, y) = 1 - S(1 - x, 1 - y)` of the same family."
+);
 
 impl TConorm {
-    /// The dual t-norm `T(x, y) = 1 - S(1 - x, 1 - y)` of the same family.
-    pub fn dual(&self) -> TNorm {
-        TNorm::from_validated(self.family)
-    }
-
     /// Evaluates `S(x, y) = 1 - T(1 - x, 1 - y)`.
     ///
     /// Inputs are clamped into `[0, 1]` (NaN counts as 0). The result is in
@@ -184,15 +176,12 @@ pub(crate) fn interior(family: Family, x: f64, y: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tests::close;
 
     fn s(family: Family, x: f32, y: f32) -> f32 {
         TConorm::new(family)
             .map(|s| s.apply(x, y))
             .unwrap_or(f32::NAN)
-    }
-
-    fn close(a: f32, b: f32) -> bool {
-        (a - b).abs() < 1e-6
     }
 
     #[test]

@@ -34,6 +34,11 @@ use proptest::test_runner::TestCaseError;
 
 use super::{Family, TConorm, TNorm};
 
+/// Whether two memberships agree within 1e-6.
+pub(crate) fn close(a: f32, b: f32) -> bool {
+    (a - b).abs() < 1e-6
+}
+
 mod extremes;
 mod reference;
 

@@ -14,23 +14,15 @@ use super::numeric::{logistic, logit, ordered, p_norm, to_unit, unit};
 use super::validated::validated_family;
 use super::{Family, OperatorError, TConorm, frank};
 
-/// A validated t-norm (fuzzy AND) of one [`Family`].
-///
-/// Serialises as its [`Family`]; deserialising validates the parameter.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "Family", into = "Family")]
-pub struct TNorm {
-    family: Family,
-}
-
-validated_family!(TNorm, "t-norm");
+validated_family!(
+    /// A validated t-norm (fuzzy AND) of one [`Family`].
+    TNorm,
+    "t-norm",
+    dual: TConorm,
+    "The dual t-conorm `S(x, y) = 1 - T(1 - x, 1 - y)` of the same family."
+);
 
 impl TNorm {
-    /// The dual t-conorm `S(x, y) = 1 - T(1 - x, 1 - y)` of the same family.
-    pub fn dual(&self) -> TConorm {
-        TConorm::from_validated(self.family)
-    }
-
     /// Evaluates `T(x, y)`.
     ///
     /// Inputs are clamped into `[0, 1]` (NaN counts as 0). The result is in
@@ -172,15 +164,12 @@ pub(crate) fn schweizer_sklar(x: f64, y: f64, p: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tests::close;
 
     fn t(family: Family, x: f32, y: f32) -> f32 {
         TNorm::new(family)
             .map(|t| t.apply(x, y))
             .unwrap_or(f32::NAN)
-    }
-
-    fn close(a: f32, b: f32) -> bool {
-        (a - b).abs() < 1e-6
     }
 
     #[test]

@@ -1,11 +1,20 @@
 //! What a t-norm and a t-conorm share: a [`Family`](crate::Family) whose parameter has been
 //! validated, made from a family only through validation, and turned back into its family.
 
-/// Implements, for an operator type holding one validated `family: Family` field: `new` (the
-/// only way from a family, validating it), `from_validated` (for the dual of a valid
-/// operator), `family`, and the `TryFrom<Family>`/`From<_> for Family` pair serde goes through.
+/// Declares an operator type holding one validated `family: Family`, with `new` (the only way
+/// from a family, validating it), `from_validated` (for the dual of a valid operator),
+/// `family`, `dual`, and the `TryFrom<Family>`/`From<_> for Family` pair serde goes through.
 macro_rules! validated_family {
-    ($operator:ident, $what:literal) => {
+    ($(#[$doc:meta])* $operator:ident, $what:literal, dual: $dual:ident, $dual_doc:literal) => {
+        $(#[$doc])*
+        ///
+        /// Serialises as its [`Family`]; deserialising validates the parameter.
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(try_from = "Family", into = "Family")]
+        pub struct $operator {
+            family: Family,
+        }
+
         impl $operator {
             #[doc = concat!("Creates the ", $what, " of `family` after validating its parameter.")]
             ///
@@ -26,6 +35,11 @@ macro_rules! validated_family {
             #[doc = concat!("The family this ", $what, " belongs to.")]
             pub fn family(&self) -> Family {
                 self.family
+            }
+
+            #[doc = $dual_doc]
+            pub fn dual(&self) -> $dual {
+                $dual::from_validated(self.family)
             }
         }
 
