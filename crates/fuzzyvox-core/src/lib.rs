@@ -6,6 +6,8 @@
 //! - [`class`] and [`measures`]: a voxel's class, and the measures (ambiguity,
 //!   indeterminacy, safety) derived from its two memberships;
 //! - [`geometry`]: pinhole intrinsics and poses;
+//! - [`image`]: grayscale images, posed [`Frame`]s and the [`StereoGeometry`] of a rectified
+//!   pair, as file readers make them and the depth stage takes them;
 //! - [`storage`]: sparse 8×8×8 blocks with `i32` keys ([`BlockGrid`], [`Resolution`]);
 //! - [`integrate`]: [`PointCloud`]s (exact ray walk) and [`DepthFrame`]s with depth intervals
 //!   (projective frustum), into [`ScanEvidence`];
@@ -50,6 +52,7 @@ pub mod class;
 pub mod error;
 pub mod file;
 pub mod geometry;
+pub mod image;
 pub mod integrate;
 pub mod map;
 pub mod measures;
@@ -57,6 +60,7 @@ pub mod storage;
 
 pub use error::{Error, FormatError, Result};
 pub use geometry::{PinholeIntrinsics, pose_from_matrix, validate_pose};
+pub use image::{Frame, GrayImage, StereoGeometry};
 pub use integrate::{
     DepthFrame, Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats,
     IntervalDepthImage, PointCloud, ScanEvidence,

@@ -9,7 +9,7 @@ use std::path::Path;
 const LAYERS: &[&[&str]] = &[
     &["class", "error"],
     &["measures", "geometry", "storage"],
-    &["integrate"],
+    &["integrate", "image"],
     &["map"],
     &["file"],
 ];

@@ -24,7 +24,6 @@ use fuzzyvox_core::{error, geometry, integrate};
 
 mod census;
 mod frame;
-mod gray;
 mod interval;
 mod matching;
 mod metrics;
@@ -43,8 +42,8 @@ pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
     census_transform,
 };
-pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
-pub use gray::GrayImage;
+pub use frame::{PairCriteria, PairSelector, SelectedPair};
+pub use fuzzyvox_core::image::{Frame, GrayImage, MIN_BASELINE, StereoGeometry};
 pub use interval::{
     IntervalMethod, IntervalParams, RELIABLE_COST, confidence, interval_image, match_reliability,
 };
@@ -57,7 +56,7 @@ pub use pipeline::{
     depth_from_views,
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
-pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry};
+pub use rectify::{Rectification, Side};
 pub use stream::{DepthStream, SkipReason, StreamCounts};
 pub use sweep::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
 pub use texture::textureless;

@@ -15,10 +15,10 @@
 //! arithmetic up to the sub-pixel step is on integers, so the result is the same for any number
 //! of threads and any band split.
 
+use fuzzyvox_core::image::GrayImage;
 use rayon::prelude::*;
 
 use super::census::{CENSUS_MAX_COST, CensusCode, CensusImage, census_transform};
-use super::gray::GrayImage;
 use super::params::{DisparityMap, MatchParams};
 use super::scan::{min_lane, scan_column};
 use super::texture::drop_textureless;

@@ -32,13 +32,12 @@
 //! that threads sweep independently (each band with a halo of half a window), keeping the
 //! band's aggregated costs on every plane (at most 32 rows × width × 1024 planes × 2 bytes).
 
+use fuzzyvox_core::image::{Frame, MIN_BASELINE, StereoGeometry};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 
 use super::census::{CENSUS_BITS, CENSUS_MAX_COST, CensusImage, census_transform};
-use super::frame::Frame;
 use super::params::{DisparityMap, MAX_DISPARITIES, MatchParams};
-use super::rectify::{MIN_BASELINE, StereoGeometry};
 use super::texture::drop_textureless;
 use crate::error::UnrectifiableReason;
 use crate::error::{Error, Result};
