@@ -23,16 +23,12 @@
 )]
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 
-use fuzzyvox_core::{error, file, geometry, integrate, map, measures, storage};
-use fuzzyvox_depth as depth;
-
 mod bounded;
 mod cloud_text;
 mod gray;
 mod load;
 pub mod middlebury;
 pub mod octomap;
-pub mod palette;
 pub mod pfm;
 pub mod ply;
 pub mod posed;

@@ -23,10 +23,6 @@
     )
 )]
 
-use fuzzyvox_core::{error, geometry};
-use fuzzyvox_depth as depth;
-use fuzzyvox_io as io;
-
 pub mod export;
 mod render;
 pub mod scenario;

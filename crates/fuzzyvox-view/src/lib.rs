@@ -19,10 +19,6 @@
     )
 )]
 
-use fuzzyvox_core::{error, map, measures, storage};
-use fuzzyvox_figure as figure;
-use fuzzyvox_io as io;
-
 pub mod page;
 pub mod paths;
 

@@ -13,8 +13,8 @@
 
 use std::path::Path;
 
-use crate::error::{FormatError, Result};
-use crate::write_atomic;
+use fuzzyvox_core::error::{FormatError, Result};
+use fuzzyvox_core::file::write_atomic;
 
 use super::bt::{TREE_DEPTH, child_corner, voxel_key};
 use super::cursor::Cursor;
@@ -164,7 +164,7 @@ pub fn write_ot(path: &Path, map: &OcTreeMap) -> Result<()> {
 /// `updateInnerOccupancy` leaves them. A `.bt` tree is written with its leaves at the clamping
 /// log-odds OctoMap gives them.
 pub fn encode_ot(map: &OcTreeMap) -> Vec<u8> {
-    use crate::map::VoxelMap;
+    use fuzzyvox_core::map::VoxelMap;
     let (masks, data) = map.nodes();
     let values = map.node_values();
     let resolution = map.resolution().size();

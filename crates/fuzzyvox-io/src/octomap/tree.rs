@@ -14,14 +14,15 @@
 
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, FormatError, Result};
+use fuzzyvox_core::map::{LogOdds, LogOddsConfig, VoxelCounts, VoxelMap};
+use fuzzyvox_core::measures::{MeasureConfig, Memberships};
+use fuzzyvox_core::storage::{Resolution, VoxelKey};
+
 use super::bt::{
     BtMap, FILE_HEADER as BT_HEADER, KEY_OFFSET, TREE_DEPTH, child_corner, cube_keys, voxel_key,
 };
 use super::ot::{OT_HEADER, decode_ot};
-use crate::error::{Error, FormatError, Result};
-use crate::map::{LogOdds, LogOddsConfig, VoxelCounts, VoxelMap};
-use crate::measures::{MeasureConfig, Memberships};
-use crate::storage::{Resolution, VoxelKey};
 
 /// A leaf of an OctoMap tree with its occupancy log-odds: a cube of `side()³` voxels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,7 +92,7 @@ impl OctreeFormat {
 /// # Ok::<(), fuzzyvox_core::Error>(())
 /// ```
 ///
-/// The map is read-only: it is no [`VoxelMapMut`](crate::map::VoxelMapMut), so integrating
+/// The map is read-only: it is no [`VoxelMapMut`](fuzzyvox_core::map::VoxelMapMut), so integrating
 /// into it does not compile (start a fuzzy map from it with
 /// [`FuzzyMap::add_prior`](fuzzyvox_core::FuzzyMap::add_prior) instead):
 ///
@@ -152,8 +153,8 @@ impl OcTreeMap {
     pub fn from_bt(bt: &BtMap) -> Result<Self, FormatError> {
         let defaults = LogOddsConfig::new(bt.resolution)
             .map_err(|e| FormatError::Invalid(format!("resolution {} m: {e}", bt.resolution)))?;
-        let occupied = crate::map::logodds_of(defaults.clamp_max);
-        let free = crate::map::logodds_of(defaults.clamp_min);
+        let occupied = fuzzyvox_core::map::logodds_of(defaults.clamp_max);
+        let free = fuzzyvox_core::map::logodds_of(defaults.clamp_min);
         let leaves: Vec<OctreeLeaf> = bt
             .leaves
             .iter()
