@@ -4,22 +4,6 @@
 //! frustum integrator; and depth from several views at once ([`depth_from_views`],
 //! [`ViewWindow`]). See `docs/depth.md`.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 use fuzzyvox_core::{error, geometry, integrate};
 
 mod census;

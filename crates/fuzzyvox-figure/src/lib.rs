@@ -9,22 +9,6 @@
 //! - [`chart`]: bar and line charts as SVG and PNG (map metrics, operators, depth accuracy
 //!   against confidence).
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 pub mod chart;
 pub mod font;
 pub mod frame;

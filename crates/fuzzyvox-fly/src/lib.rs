@@ -11,22 +11,6 @@
 //! - [`report`]: the flights as JSON, figures and Markdown;
 //! - this module: every goal with every map ([`fly_all`]) and the summary per map.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 use fuzzyvox_core::{error, integrate, map, measures, storage};
 use fuzzyvox_depth as depth;
 use fuzzyvox_figure as figure;

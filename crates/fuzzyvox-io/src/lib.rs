@@ -6,21 +6,6 @@
 //! Readers take bytes from anywhere, so this crate may not index or slice: every access to
 //! file bytes is checked (`get`, `split_at_checked`, patterns), and a bad file is an error.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 
 mod bounded;
