@@ -15,6 +15,8 @@
 //!
 //! Run: `cargo bench --bench fly`.
 
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use fuzzyvox::MapKind;
 use fuzzyvox::eval::QueryConfig;

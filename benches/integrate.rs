@@ -4,6 +4,8 @@
 //! Needs `FUZZYVOX_DATA` (the shared data folder); without it the benchmarks say so and skip.
 //! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench integrate`.
 
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::VoxelMapMut;
 use std::path::PathBuf;
 

@@ -7,6 +7,8 @@
 //!
 //! Run: `cargo bench --bench pipeline`.
 
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use fuzzyvox::VoxelMapMut;
 use fuzzyvox::depth::{

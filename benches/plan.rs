@@ -3,6 +3,8 @@
 //!
 //! Run: `cargo bench --bench plan`.
 
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use fuzzyvox::map::FunctionMap;
 use fuzzyvox::plan::{CostField, PlannerConfig, PlanningRegion, VoxelGraph, plan_in_field};

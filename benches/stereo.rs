@@ -6,6 +6,8 @@
 //! Run: `FUZZYVOX_DATA=../shared/data cargo bench --bench stereo` (set `RAYON_NUM_THREADS=2`
 //! to compare with `scripts/bench-opencv-stereo.py`).
 
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};

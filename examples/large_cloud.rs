@@ -13,6 +13,8 @@
 //! Arguments: total points (default 10,000,000), points per chunk (default 100,000), resolution
 //! in metres (default 0.1).
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::VoxelMapMut;
 use std::time::Instant;
 

@@ -32,9 +32,9 @@
 //! # Ok::<(), fuzzyvox::Error>(())
 //! ```
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-pub use fuzzyvox_core::{class, error, file, geometry, integrate, map, measures, ops, storage};
+pub use fuzzyvox_core::{
+    class, error, file, geometry, image, integrate, map, measures, ops, storage,
+};
 pub use fuzzyvox_depth as depth;
 pub use fuzzyvox_eval as eval;
 pub use fuzzyvox_figure as figure;

@@ -3,6 +3,8 @@
 //! intact. The native map's truncations, bit flips and oversized length are in `bad_input.rs`;
 //! the table of every case is in `docs/robustness.md`.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use fuzzyvox::VoxelMapMut;

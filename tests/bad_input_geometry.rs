@@ -3,6 +3,8 @@
 //! error (or a documented skip) and leaves every map unchanged. The cases of `bad_input.rs` are
 //! not repeated; the table of every case is in `docs/robustness.md`.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::{room_scan, wall_frame};

@@ -1,6 +1,8 @@
 //! The standard log-odds map and the alpha-cut map: OctoMap parity on real data, the shared
 //! integration interface, thread-count independence and files.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::{data_dir, room_scan, wall_frame};

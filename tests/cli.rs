@@ -1,5 +1,7 @@
 //! The command-line tool, run as a user would.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::{data_dir, fuzzyvox, json};

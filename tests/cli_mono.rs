@@ -2,6 +2,8 @@
 //! simulated posed folder (the wall scenario as `fuzzyvox simulate` writes it) and, with
 //! `FUZZYVOX_DATA`, on real 7-Scenes frames.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use std::path::{Path, PathBuf};

@@ -1,5 +1,7 @@
 //! `fuzzyvox rgbd`: mapping a folder of RGB-D frames and checking the maps on held-out frames.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use std::path::{Path, PathBuf};

@@ -1,6 +1,8 @@
 //! Every command that works on files, run on small inputs made here (no data needed): `export`
 //! in each variant, `info` and `stereo`, each with bad inputs.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use std::path::{Path, PathBuf};

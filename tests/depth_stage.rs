@@ -1,6 +1,8 @@
 //! The depth stage end to end on synthetic views with exact ground truth, rectification
 //! geometry, pair selection, and bad inputs.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use fuzzyvox::VoxelMapMut;

@@ -3,6 +3,8 @@
 //! and the maps built from it. (Map integration alone is covered for every map kind in
 //! `baselines.rs` and `fuzzy_map.rs`.)
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::depth::{
     DepthParams, DepthResult, Frame, GrayImage, depth_from_pair, depth_from_views,
 };

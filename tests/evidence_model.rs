@@ -3,6 +3,8 @@
 //! evidence does not depend on the interval's width or the confidence; point clouds the same.
 //! The paper's model, kept for comparison, is checked beside it.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::VoxelMapMut;
 use fuzzyvox::integrate::depth_evidence;
 use fuzzyvox::storage::Resolution;

@@ -2,6 +2,8 @@
 //! title, a legend with the class colours or a viridis colour bar, a scale bar, and unknown
 //! space distinct from the background.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::room_scan;

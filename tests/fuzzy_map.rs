@@ -1,6 +1,8 @@
 //! The dual-set fuzzy map's laws: order independence, exact merges, memberships in [0, 1],
 //! thread-count independence, and what rays and frusta do to voxels.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::{room_scan, wall_frame};

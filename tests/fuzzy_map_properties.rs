@@ -2,6 +2,8 @@
 //! (exactly) and associative (to float tolerance), insertion order does not matter, and
 //! memberships stay in [0, 1], for several operator families.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::VoxelMapMut;
 use fuzzyvox::{Family, FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, TConorm, VoxelMap};
 use nalgebra::Point3;

@@ -2,6 +2,8 @@
 //! their order, however they are split into partial maps and merged, and on any number of
 //! threads (the fixed-point levels of `map::Accumulator`).
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::{data_dir, room_scan};

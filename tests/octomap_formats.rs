@@ -1,6 +1,8 @@
 //! OctoMap's formats: the real sample files, `.bt` round trips, OctoMap reading fuzzyvox's
 //! `.bt` files, and damaged input.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use std::collections::BTreeMap;

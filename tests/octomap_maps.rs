@@ -2,6 +2,8 @@
 //! planner and the exporters use, checked against OctoMap itself; opening any map file by
 //! content; and OctoMap maps as priors of a fuzzy map.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use fuzzyvox::VoxelMapMut;

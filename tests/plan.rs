@@ -1,5 +1,7 @@
 //! Planning: cost field, A* through petgraph's traits, shortcutting, typed failures, queries.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::VoxelMapMut;
 use fuzzyvox::map::FunctionMap;
 use fuzzyvox::plan::{

@@ -1,6 +1,8 @@
 //! The incremental planner: after any sequence of integrations, an updated cost field is bit for
 //! bit the field a full build gives on the same map, for every map, policy and clearance.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox::map::{AlphaConfig, AlphaCutMap, LogOddsConfig, LogOddsMap};
 use fuzzyvox::plan::{CostField, Planner, PlannerConfig, PlanningRegion, UnknownPolicy};
 use fuzzyvox::{

@@ -2,6 +2,8 @@
 //! Kinect frames. Each test says it skipped when the variable is unset and fails when it is set
 //! but the data is missing.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::data_dir;

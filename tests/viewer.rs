@@ -1,6 +1,8 @@
 //! `fuzzyvox view`: the page it writes, opened in a headless Chromium as a user would open it,
 //! and its errors on bad input.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 mod common;
 
 use common::browser::{Browser, changed_fraction};

@@ -7,8 +7,6 @@
 //! their layout allows; fuzzyvox errors become `fuzzyvox.FuzzyvoxError` subclasses carrying the
 //! Rust message.
 
-#![forbid(unsafe_code)]
-
 mod arrays;
 mod errors;
 mod maps;

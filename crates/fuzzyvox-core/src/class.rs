@@ -1,5 +1,6 @@
 //! The four classes a voxel can fall in: plain data that storage counts and measures decide,
-//! so that storage does not depend on how classes are computed.
+//! so that storage does not depend on how classes are computed; and each class's colour, the
+//! same in every figure, PLY export and viewer page.
 
 use serde::{Deserialize, Serialize};
 
@@ -39,5 +40,17 @@ impl VoxelClass {
             Self::Ambiguous => "ambiguous",
             Self::Unknown => "unknown",
         }
+    }
+}
+
+/// The colour of each class, everywhere (figures, PLY export, viewer page): occupied near black,
+/// free light green, ambiguous orange, unknown light grey (the table in `fuzzyvox-figure`'s
+/// `palette`).
+pub const fn class_color(class: VoxelClass) -> [u8; 3] {
+    match class {
+        VoxelClass::Occupied => [40, 40, 40],
+        VoxelClass::Free => [150, 210, 150],
+        VoxelClass::Ambiguous => [235, 140, 30],
+        VoxelClass::Unknown => [215, 215, 215],
     }
 }

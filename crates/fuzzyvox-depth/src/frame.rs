@@ -1,75 +1,12 @@
-//! Posed frames and the choice of a stereo partner for each new frame.
+//! The choice of a stereo partner for each new posed frame ([`Frame`], from the core).
 
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, Vector3};
+use fuzzyvox_core::image::Frame;
 
-use super::gray::GrayImage;
 use super::quality::{ExtrinsicQuality, extrinsic_quality};
 use fuzzyvox_core::error::{Error, Result};
-use fuzzyvox_core::geometry::{PinholeIntrinsics, validate_pose};
-
-/// One posed image of the stream.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Frame {
-    image: GrayImage,
-    intrinsics: PinholeIntrinsics,
-    world_from_camera: Isometry3<f64>,
-    timestamp: f64,
-}
-
-impl Frame {
-    /// A frame: the image size must match the intrinsics, the pose be valid and the timestamp
-    /// (seconds) finite.
-    pub fn new(
-        image: GrayImage,
-        intrinsics: PinholeIntrinsics,
-        world_from_camera: Isometry3<f64>,
-        timestamp: f64,
-    ) -> Result<Self> {
-        validate_pose(&world_from_camera)?;
-        fuzzyvox_core::error::finite("timestamp", timestamp)?;
-        if image.width() != intrinsics.width() || image.height() != intrinsics.height() {
-            return Err(Error::SizeMismatch {
-                what: "frame image pixels (intrinsics width × height)",
-                expected: intrinsics.width() as usize * intrinsics.height() as usize,
-                found: image.pixels().len(),
-            });
-        }
-        Ok(Self {
-            image,
-            intrinsics,
-            world_from_camera,
-            timestamp,
-        })
-    }
-
-    /// The image.
-    pub fn image(&self) -> &GrayImage {
-        &self.image
-    }
-
-    /// The camera.
-    pub fn intrinsics(&self) -> &PinholeIntrinsics {
-        &self.intrinsics
-    }
-
-    /// The pose.
-    pub fn world_from_camera(&self) -> &Isometry3<f64> {
-        &self.world_from_camera
-    }
-
-    /// Time (s).
-    pub fn timestamp(&self) -> f64 {
-        self.timestamp
-    }
-
-    /// Look direction (camera +z) in the world.
-    pub fn look_direction(&self) -> Vector3<f64> {
-        self.world_from_camera.rotation * Vector3::z()
-    }
-}
 
 /// What makes an earlier frame an acceptable partner.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,9 +74,9 @@ impl PairCriteria {
 
     /// Whether `earlier` may pair with `current`.
     pub fn accepts(&self, current: &Frame, earlier: &Frame) -> bool {
-        let dt = current.timestamp - earlier.timestamp;
-        let baseline = (current.world_from_camera.translation.vector
-            - earlier.world_from_camera.translation.vector)
+        let dt = current.timestamp() - earlier.timestamp();
+        let baseline = (current.world_from_camera().translation.vector
+            - earlier.world_from_camera().translation.vector)
             .norm();
         let angle = current.look_direction().angle(&earlier.look_direction());
         dt >= 0.0
@@ -192,17 +129,17 @@ impl PairSelector {
     /// time order; frames older than the time window are dropped.
     pub fn push(&mut self, frame: Frame) -> Result<Option<SelectedPair>> {
         if let Some(last) = self.frames.back()
-            && frame.timestamp < last.timestamp
+            && frame.timestamp() < last.timestamp()
         {
             return Err(Error::InvalidParameter {
                 name: "timestamp",
-                value: frame.timestamp,
+                value: frame.timestamp(),
                 expected: "frames in non-decreasing time order",
             });
         }
         let current = Arc::new(frame);
-        let horizon = current.timestamp - self.criteria.time_window;
-        while self.frames.front().is_some_and(|f| f.timestamp < horizon) {
+        let horizon = current.timestamp() - self.criteria.time_window;
+        while self.frames.front().is_some_and(|f| f.timestamp() < horizon) {
             self.frames.pop_front();
         }
         let mut best: Option<(Arc<Frame>, ExtrinsicQuality)> = None;
@@ -211,7 +148,7 @@ impl PairSelector {
                 continue;
             }
             let quality =
-                extrinsic_quality(&current.world_from_camera, &earlier.world_from_camera)?;
+                extrinsic_quality(current.world_from_camera(), earlier.world_from_camera())?;
             if quality.q > 0.0 && best.as_ref().is_none_or(|(_, b)| quality.q > b.q) {
                 best = Some((Arc::clone(earlier), quality));
             }

@@ -8,8 +8,9 @@
 //!
 //! Confidence (paper eq. 10): `C = max(100 - a (P+ - P-), 0) · Q`, stored divided by 100.
 
+use fuzzyvox_core::image::StereoGeometry;
+
 use super::params::DisparityMap;
-use super::rectify::StereoGeometry;
 use fuzzyvox_core::error::{Error, Result};
 use fuzzyvox_core::integrate::IntervalDepthImage;
 

@@ -4,25 +4,8 @@
 //! frustum integrator; and depth from several views at once ([`depth_from_views`],
 //! [`ViewWindow`]). See `docs/depth.md`.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 mod census;
 mod frame;
-mod gray;
 mod interval;
 mod matching;
 mod metrics;
@@ -40,9 +23,9 @@ pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
     census_transform,
 };
-pub use frame::{Frame, PairCriteria, PairSelector, SelectedPair};
+pub use frame::{PairCriteria, PairSelector, SelectedPair};
 pub use fuzzyvox_core::error::UnrectifiableReason;
-pub use gray::GrayImage;
+pub use fuzzyvox_core::image::{Frame, GrayImage, MIN_BASELINE, StereoGeometry};
 pub use interval::{
     IntervalMethod, IntervalParams, RELIABLE_COST, confidence, interval_image, match_reliability,
 };
@@ -55,7 +38,7 @@ pub use pipeline::{
     depth_from_views,
 };
 pub use quality::{ExtrinsicQuality, extrinsic_quality, quality_from_vectors};
-pub use rectify::{MIN_BASELINE, Rectification, Side, StereoGeometry};
+pub use rectify::{Rectification, Side};
 pub use stream::{DepthStream, SkipReason, StreamCounts};
 pub use sweep::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
 pub use texture::textureless;

@@ -1,11 +1,11 @@
 //! The matcher's parameters and its result.
 
+pub use fuzzyvox_core::image::MAX_DISPARITIES;
+
 use fuzzyvox_core::error::{Error, Result};
 
 /// Largest supported aggregation window side; keeps window sums inside `i16`.
 pub const MAX_WINDOW: u32 = 15;
-/// Largest supported number of disparities.
-pub const MAX_DISPARITIES: u32 = 1024;
 
 /// The default [`MatchParams::min_contrast`]: 0.5 %. The simulator's sky has a window contrast
 /// of 0.1-0.3 % (a brightness gradient and sensor noise), its textured surfaces 1.2 % and up

@@ -3,13 +3,14 @@
 
 use std::time::Instant;
 
-use super::frame::{Frame, SelectedPair};
-use super::gray::GrayImage;
+use fuzzyvox_core::image::{Frame, GrayImage, StereoGeometry};
+
+use super::frame::SelectedPair;
 use super::interval::{IntervalParams, interval_image};
 use super::matching::match_pair;
 use super::params::{DisparityMap, MatchParams};
 use super::quality::extrinsic_quality;
-use super::rectify::{Rectification, Side, StereoGeometry, epipole_within};
+use super::rectify::{Rectification, Side, epipole_within};
 use super::sweep::{Sweep, sweep_views};
 use fuzzyvox_core::error::UnrectifiableReason;
 use fuzzyvox_core::error::{Error, Result};

@@ -11,7 +11,8 @@
 //! pixel when the contrast is below [`MatchParams::min_contrast`]. OpenCV's block matcher has
 //! the same safeguard (`textureThreshold`) on an absolute scale.
 
-use super::gray::GrayImage;
+use fuzzyvox_core::image::GrayImage;
+
 use super::params::{DisparityMap, MatchParams};
 
 /// Whether each pixel's `window_width × window_height` window (clamped at the borders, `NaN`

@@ -1,7 +1,8 @@
 //! A window of a flight's recent frames, so that each new pair is matched together with the
 //! earlier camera positions (multi-view depth, see [`depth_from_views`]).
 
-use super::frame::Frame;
+use fuzzyvox_core::image::Frame;
+
 use super::pipeline::{DepthParams, DepthResult, depth_from_pair, depth_from_views};
 use super::sweep::{MAX_SWEEP_VIEWS, PLANE_COUNT};
 use fuzzyvox_core::error::{Error, Result};

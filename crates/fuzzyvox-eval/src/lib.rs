@@ -12,22 +12,6 @@
 //! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
 //! ray-casting them into held-out frames.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 mod charts;
 pub mod closed_loop;
 mod depth_stage;

@@ -4,12 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use ::image::RgbImage;
+use fuzzyvox_core::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::font::{self, FAMILY};
 use super::frame::{draw_title, figure_error, rgb, tick};
-use crate::error::{Error, Result};
 
 /// Colours of categories, in order (a qualitative palette readable by most colour-blind
 /// readers).
@@ -113,7 +113,7 @@ impl Chart {
     pub fn save(&self, stem: &Path) -> Result<[PathBuf; 2]> {
         let svg = stem.with_extension("svg");
         let png = stem.with_extension("png");
-        crate::io::write_atomic(&svg, self.to_svg()?.as_bytes())?;
+        fuzzyvox_core::file::write_atomic(&svg, self.to_svg()?.as_bytes())?;
         super::save_png(&self.to_png()?, &png)?;
         Ok([svg, png])
     }

@@ -2,13 +2,13 @@
 //! a scale bar, paths drawn over it, and a legend (the class colours, or a colour bar with the
 //! measure's range).
 
+use fuzzyvox_core::error::{Error, Result};
 use image::RgbImage;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::font::{self, FAMILY};
 use super::palette;
-use crate::error::{Error, Result};
 
 /// The long side of a figure's plot, at least (pixels).
 pub const MIN_LONG_SIDE: u32 = 800;

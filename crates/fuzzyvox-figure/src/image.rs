@@ -3,12 +3,12 @@
 //! black and the legend says so.
 
 use ::image::RgbImage;
+use fuzzyvox_core::error::{Error, Result};
 use plotters::prelude::*;
 
 use super::font::{self, FAMILY};
 use super::frame::{draw_title, figure_error, rgb, tick};
 use super::palette::{NO_VALUE, viridis};
-use crate::error::{Error, Result};
 
 /// One panel: a plane of values and how to colour it.
 #[derive(Clone, Debug)]

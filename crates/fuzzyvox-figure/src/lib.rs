@@ -9,44 +9,24 @@
 //! - [`chart`]: bar and line charts as SVG and PNG (map metrics, operators, depth accuracy
 //!   against confidence).
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
-use fuzzyvox_core::{error, map, measures, storage};
-use fuzzyvox_io as io;
-
 pub mod chart;
 pub mod font;
 pub mod frame;
 pub mod image;
-pub use fuzzyvox_io::palette;
+pub mod palette;
 pub mod view;
 
 use std::path::Path;
 
 pub use chart::{BarPanel, Chart, LinePanel, Panel};
 pub use frame::{Legend, MIN_LONG_SIDE, MapFigure, Overlay};
+use fuzzyvox_core::error::{Error, Result};
 pub use image::{ImagePanel, image_figure};
 pub use palette::{class_color, viridis};
 pub use view::{
     MapRaster, View, ViewColor, ViewSpec, legend_for, rasterize, render_view, view_figure,
     write_view_png,
 };
-
-use crate::error::{Error, Result};
 
 /// Encodes `figure` as PNG and writes it to `path` atomically (a failed write leaves no half
 /// file).
@@ -61,5 +41,5 @@ pub fn save_png(figure: &::image::RgbImage, path: &Path) -> Result<()> {
             path: path.to_path_buf(),
             source: std::io::Error::other(e),
         })?;
-    crate::io::write_atomic(path, &bytes)
+    fuzzyvox_core::file::write_atomic(path, &bytes)
 }

@@ -17,14 +17,14 @@
 
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, Result, finite};
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::{Measures, VoxelClass};
+use fuzzyvox_core::storage::VoxelKey;
 use image::RgbImage;
 
 use super::frame::{Legend, MapFigure, Overlay};
 use super::palette::{UNKNOWN, class_color, viridis};
-use crate::error::{Error, Result, finite};
-use crate::map::VoxelMap;
-use crate::measures::{Measures, VoxelClass};
-use crate::storage::VoxelKey;
 
 /// Where the view looks from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -431,9 +431,9 @@ fn rank(class: VoxelClass) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::map::VoxelMapMut;
-    use crate::map::{FuzzyConfig, FuzzyMap, VoxelMap};
     use fuzzyvox_core::integrate::{IntegrationOptions, PointCloud};
+    use fuzzyvox_core::map::VoxelMapMut;
+    use fuzzyvox_core::map::{FuzzyConfig, FuzzyMap, VoxelMap};
     use nalgebra::Point3;
 
     /// A vertical wall at x = 2 m, y in [0, 1), z in [0, 0.5), seen from (0, 0.5, 0.25).

@@ -5,7 +5,7 @@
 use std::io::{BufRead, Read};
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
 
 /// Longest line a text format may have (1 MiB; real lines are under 200 bytes).
 pub(crate) const MAX_LINE_BYTES: u64 = 1 << 20;

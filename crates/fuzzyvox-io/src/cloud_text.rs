@@ -1,11 +1,11 @@
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::integrate::PointCloud;
 use nalgebra::Point3;
 
 use super::bounded::ContentLines;
-use crate::error::{Error, Result};
-use crate::integrate::PointCloud;
 
 /// Reads a plain text point cloud: one point per line as `x y z` or `x y z confidence`
 /// (separated by spaces, tabs or commas), metres in the world frame, confidence in `[0, 1]`.

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use crate::depth::GrayImage;
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::image::GrayImage;
 
 /// Reads a PNG or JPEG image file as a [`GrayImage`]. A missing file is [`Error::Io`]; any other
 /// format, or a damaged file, is [`Error::Parse`] naming the file.

@@ -6,25 +6,7 @@
 //! Readers take bytes from anywhere, so this crate may not index or slice: every access to
 //! file bytes is checked (`get`, `split_at_checked`, patterns), and a bad file is an error.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
-
-use fuzzyvox_core::{error, file, geometry, integrate, map, measures, storage};
-use fuzzyvox_depth as depth;
 
 mod bounded;
 mod cloud_text;
@@ -32,7 +14,6 @@ mod gray;
 mod load;
 pub mod middlebury;
 pub mod octomap;
-pub mod palette;
 pub mod pfm;
 pub mod ply;
 pub mod posed;

@@ -4,10 +4,11 @@
 use std::io::Read;
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, FormatError, Result};
+use fuzzyvox_core::file::{MAGIC, MapHeader};
+use fuzzyvox_core::map::{AnyMap, VoxelMap};
+
 use super::octomap::{OcTreeMap, OctreeFormat};
-use crate::error::{Error, FormatError, Result};
-use crate::file::{MAGIC, MapHeader};
-use crate::map::{AnyMap, VoxelMap};
 
 /// The first line of OctoMap's binary trees (`.bt`) and full trees (`.ot`).
 const BT_FIRST_LINE: &[u8] = b"# Octomap OcTree binary file";

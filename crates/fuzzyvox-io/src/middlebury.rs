@@ -4,13 +4,13 @@
 
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::geometry::PinholeIntrinsics;
+use fuzzyvox_core::image::{GrayImage, StereoGeometry};
 use nalgebra::Isometry3;
 
 use super::gray::read_gray_image;
 use super::pfm::{FloatImage, read_pfm};
-use crate::depth::{GrayImage, StereoGeometry};
-use crate::error::{Error, Result};
-use crate::geometry::PinholeIntrinsics;
 
 /// The contents of a Middlebury `calib.txt`.
 #[derive(Clone, Debug, PartialEq)]

@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
-use crate::error::{Error, FormatError, Result};
-use crate::file::write_atomic;
+use fuzzyvox_core::error::{Error, FormatError, Result};
+use fuzzyvox_core::file::write_atomic;
 
 /// The largest map accepted (pixels): far above any camera, far below what a corrupt header
 /// could claim, so a damaged file never triggers a huge allocation.

@@ -11,11 +11,11 @@
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-use crate::error::Result;
-use crate::file::write_atomic_with;
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-pub use crate::palette::class_color;
+pub use fuzzyvox_core::class::class_color;
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::file::write_atomic_with;
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
 
 /// How the vertices are stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -105,9 +105,9 @@ pub fn write_ply(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::{IntegrationOptions, PointCloud};
-    use crate::map::VoxelMapMut;
-    use crate::map::{FuzzyConfig, FuzzyMap};
+    use fuzzyvox_core::integrate::{IntegrationOptions, PointCloud};
+    use fuzzyvox_core::map::VoxelMapMut;
+    use fuzzyvox_core::map::{FuzzyConfig, FuzzyMap};
     use nalgebra::Point3;
 
     fn small_map() -> FuzzyMap {

@@ -14,14 +14,14 @@
 
 use std::path::{Path, PathBuf};
 
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::geometry::{PinholeIntrinsics, validate_pose};
+use fuzzyvox_core::image::Frame;
+use fuzzyvox_core::integrate::DepthFrame;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
 use super::gray::read_gray_image;
 use super::rgbd::{kinect_interval_image, read_depth_png_mm, read_intrinsics_txt, read_pose_txt};
-use crate::depth::Frame;
-use crate::error::{Error, Result};
-use crate::geometry::{PinholeIntrinsics, validate_pose};
-use crate::integrate::DepthFrame;
 
 /// Frames per second assumed for frame numbers without a trajectory's timestamps (a frame's
 /// time is `N / 30` s, the rate of the Kinect that recorded 7-Scenes).

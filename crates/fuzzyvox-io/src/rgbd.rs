@@ -4,11 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::geometry::{PinholeIntrinsics, pose_from_matrix};
+use fuzzyvox_core::integrate::{DepthFrame, IntervalDepthImage};
 use nalgebra::{Isometry3, Matrix4};
-
-use crate::error::{Error, Result};
-use crate::geometry::{PinholeIntrinsics, pose_from_matrix};
-use crate::integrate::{DepthFrame, IntervalDepthImage};
 
 /// A depth image in metres, row-major; 0 where the sensor gave no reading.
 #[derive(Clone, Debug, PartialEq)]

@@ -5,11 +5,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::file::write_atomic;
+use fuzzyvox_core::geometry::PinholeIntrinsics;
 use nalgebra::Isometry3;
-
-use crate::error::{Error, Result};
-use crate::file::write_atomic;
-use crate::geometry::PinholeIntrinsics;
 
 fn encode_error(path: &Path, error: image::ImageError) -> Error {
     Error::Io {

@@ -19,22 +19,6 @@
 //!    around the blocks the map reports changed ([`VoxelMap::changed_blocks_since`](fuzzyvox_core::VoxelMap::changed_blocks_since)),
 //!    with exactly the result of a full build, so a closed loop can replan every frame.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
 mod astar;
 mod blocker;
 mod config;

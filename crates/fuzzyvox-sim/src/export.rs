@@ -6,12 +6,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::scenario::Scenario;
-use crate::error::Result;
-use crate::io::rgbd_write::{
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::file::write_atomic;
+use fuzzyvox_io::rgbd_write::{
     write_depth_png_mm, write_gray_png, write_intrinsics_txt, write_pose_txt,
 };
-use crate::io::write_atomic;
+
+use super::scenario::Scenario;
 
 /// Writes every pair's two views as frames `2i` (reference) and `2i + 1` (other), with the
 /// sensor noise of `seed` (the same views the experiment runner renders), and `pairs.txt`.

@@ -7,26 +7,6 @@
 //! Everything is deterministic for a seed: the same scene, camera and seed give the same image
 //! bit for bit, on any number of threads.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
-use fuzzyvox_core::{error, geometry};
-use fuzzyvox_depth as depth;
-use fuzzyvox_io as io;
-
 pub mod export;
 mod render;
 pub mod scenario;

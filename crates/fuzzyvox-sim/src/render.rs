@@ -1,11 +1,11 @@
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::geometry::PinholeIntrinsics;
+use fuzzyvox_core::image::{Frame, GrayImage};
 use nalgebra::{Isometry3, Vector3};
 use rayon::prelude::*;
 
 use super::scene::Scene;
 use super::texture::{albedo, scramble, unit_hash};
-use crate::depth::{Frame, GrayImage};
-use crate::error::Result;
-use crate::geometry::PinholeIntrinsics;
 
 /// A rendered view: a grayscale image in `[0, 1]` and the true depth along the optical axis
 /// (NaN where the ray meets nothing: sky), both row-major.

@@ -1,14 +1,14 @@
 //! The paper's two scenarios: a wall seen first by strafing and then by receding cameras, and a
 //! random flight over terrain with buildings and trees.
 
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::geometry::PinholeIntrinsics;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::render::{RenderedFrame, render};
 use super::scene::{Scene, SurfaceKind};
 use super::texture::unit_hash;
 use super::trajectory::{look_at, random_flight};
-use crate::error::Result;
-use crate::geometry::PinholeIntrinsics;
 
 /// A scene, a camera, and the stereo pairs taken along a flight through it.
 #[derive(Clone)]

@@ -135,7 +135,7 @@ mod tests {
         assert!((pose.rotation * Vector3::z() - Vector3::x()).norm() < 1e-12);
         assert!((pose.rotation * Vector3::x() + Vector3::y()).norm() < 1e-12);
         assert!((pose.rotation * Vector3::y() + Vector3::z()).norm() < 1e-12);
-        crate::geometry::validate_pose(&look_at(Point3::origin(), Vector3::z())).unwrap();
+        fuzzyvox_core::geometry::validate_pose(&look_at(Point3::origin(), Vector3::z())).unwrap();
     }
 
     #[test]

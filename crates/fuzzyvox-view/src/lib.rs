@@ -3,26 +3,6 @@
 //! metres, trajectories and flights, hover to read a voxel) that opens offline by double click.
 //! The page's script and markup live in `assets/` and are written by fuzzyvox alone.
 
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
-// Bad input is an error, never a panic: the library may not unwrap, expect or panic outside its
-// tests (tests, benches and examples may).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::unreachable
-    )
-)]
-
-use fuzzyvox_core::{error, map, measures, storage};
-use fuzzyvox_figure as figure;
-use fuzzyvox_io as io;
-
 pub mod page;
 pub mod paths;
 

@@ -12,17 +12,16 @@
 use std::path::Path;
 
 use base64::Engine as _;
-use serde::Serialize;
-use serde_json::json;
-
-use crate::error::{Error, Result};
-use crate::figure::ViewColor;
-use crate::figure::palette::{
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_core::measures::VoxelClass;
+use fuzzyvox_core::storage::VoxelKey;
+use fuzzyvox_figure::ViewColor;
+use fuzzyvox_figure::palette::{
     PATH_COLLIDES, PATH_OK, PATH_OTHER, PATH_TRAJECTORY, VIRIDIS, class_color,
 };
-use crate::map::VoxelMap;
-use crate::measures::VoxelClass;
-use crate::storage::VoxelKey;
+use serde::Serialize;
+use serde_json::json;
 
 const TEMPLATE: &str = include_str!("assets/viewer.html");
 const SCRIPT: &str = include_str!("assets/viewer.js");
@@ -298,7 +297,7 @@ pub fn write_viewer_page(
     path: &Path,
 ) -> Result<PageSummary> {
     let (page, summary) = viewer_page(map, options)?;
-    crate::io::write_atomic(path, page.as_bytes())?;
+    fuzzyvox_core::file::write_atomic(path, page.as_bytes())?;
     Ok(summary)
 }
 
@@ -321,8 +320,8 @@ pub fn escape_html(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::map::{FuzzyConfig, FuzzyMap, VoxelMapMut};
     use fuzzyvox_core::integrate::{IntegrationOptions, PointCloud};
+    use fuzzyvox_core::map::{FuzzyConfig, FuzzyMap, VoxelMapMut};
     use nalgebra::Point3;
 
     fn map() -> FuzzyMap {

@@ -4,10 +4,10 @@
 
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, Result};
 use serde_json::Value;
 
 use super::page::{PagePath, PathKind};
-use crate::error::{Error, Result};
 
 /// Largest paths file read (64 MiB).
 pub const MAX_PATHS_BYTES: u64 = 64 << 20;
@@ -28,14 +28,14 @@ pub fn read_paths(path: &Path) -> Result<Vec<PagePath>> {
     if bytes.len() as u64 > MAX_PATHS_BYTES {
         return Err(Error::Format {
             path: path.to_path_buf(),
-            reason: crate::error::FormatError::Invalid(format!(
+            reason: fuzzyvox_core::error::FormatError::Invalid(format!(
                 "longer than {MAX_PATHS_BYTES} bytes: not a paths file"
             )),
         });
     }
     parse_paths(&bytes).map_err(|reason| Error::Format {
         path: path.to_path_buf(),
-        reason: crate::error::FormatError::Invalid(reason),
+        reason: fuzzyvox_core::error::FormatError::Invalid(reason),
     })
 }
 

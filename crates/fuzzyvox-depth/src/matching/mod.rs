@@ -22,9 +22,9 @@ use fuzzyvox_core::error::{Error, Result};
 use rayon::prelude::*;
 
 use crate::census::{CENSUS_MAX_COST, CensusImage, census_transform};
-use crate::gray::GrayImage;
 use crate::params::{DisparityMap, MatchParams};
 use crate::texture::drop_textureless;
+use fuzzyvox_core::image::GrayImage;
 
 mod context;
 mod cost;

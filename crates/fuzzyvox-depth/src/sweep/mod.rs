@@ -40,9 +40,9 @@ use fuzzyvox_core::error::{Error, Result};
 use rayon::prelude::*;
 
 use crate::census::{CENSUS_MAX_COST, census_transform};
-use crate::frame::Frame;
 use crate::params::{DisparityMap, MatchParams};
 use crate::texture::drop_textureless;
+use fuzzyvox_core::image::Frame;
 
 mod band;
 mod costs;

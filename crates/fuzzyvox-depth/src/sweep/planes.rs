@@ -6,9 +6,9 @@ use fuzzyvox_core::error::{Error, Result, UnrectifiableReason};
 use nalgebra::{Matrix3, Vector3};
 
 use super::limits::{MAX_SWEEP_PIXELS, MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS, PLANE_COUNT};
-use crate::frame::Frame;
 use crate::params::MAX_DISPARITIES;
-use crate::rectify::{MIN_BASELINE, StereoGeometry};
+use fuzzyvox_core::image::Frame;
+use fuzzyvox_core::image::{MIN_BASELINE, StereoGeometry};
 
 /// One other view of a sweep: where a reference pixel lands in it on each plane.
 #[derive(Clone, Debug)]

@@ -21,8 +21,8 @@
 
 use std::path::Path;
 
-use crate::error::{Error, FormatError, Result};
-use crate::storage::VoxelKey;
+use fuzzyvox_core::error::{Error, FormatError, Result};
+use fuzzyvox_core::storage::VoxelKey;
 
 use super::cursor::Cursor;
 use super::header::{decode_declared, parse_header};

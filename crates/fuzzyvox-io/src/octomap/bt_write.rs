@@ -2,9 +2,9 @@
 
 use std::path::Path;
 
-use crate::error::{Error, Result, finite};
-use crate::storage::VoxelKey;
-use crate::write_atomic;
+use fuzzyvox_core::error::{Error, Result, finite};
+use fuzzyvox_core::file::write_atomic;
+use fuzzyvox_core::storage::VoxelKey;
 
 use super::bt::{FILE_HEADER, KEY_OFFSET, TREE_DEPTH};
 
@@ -157,7 +157,7 @@ fn build(codes: &[u64], depth: u8, out: &mut Vec<u8>, nodes: &mut usize) -> Buil
 /// numbers of occupied and free voxels written.
 pub fn write_bt_max_likelihood(
     path: &std::path::Path,
-    map: &dyn crate::map::VoxelMap,
+    map: &dyn fuzzyvox_core::map::VoxelMap,
 ) -> Result<(usize, usize)> {
     let voxels: Vec<_> = map
         .cells()

@@ -3,7 +3,7 @@
 //! Every read checks the remaining length first and reports a truncation as a
 //! [`FormatError`], so damaged files can never make a reader index out of bounds.
 
-use crate::error::FormatError;
+use fuzzyvox_core::error::FormatError;
 
 /// Reads little-endian values from a byte slice, front to back.
 pub(super) struct Cursor<'a> {

@@ -20,12 +20,12 @@
 
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, FormatError, Result};
+use fuzzyvox_core::geometry::validate_pose;
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use super::cursor::Cursor;
 use super::scan::ScanNode;
-use crate::error::{Error, FormatError, Result};
-use crate::geometry::validate_pose;
 
 /// Bytes of a stored vector: the element-count tag and three doubles.
 const VECTOR_BYTES: usize = 4 + 3 * 8;

@@ -9,7 +9,7 @@
 //! data                                  the tree follows the end of this line
 //! ```
 
-use crate::error::FormatError;
+use fuzzyvox_core::error::FormatError;
 
 /// What the header says, and where the tree data begins.
 pub(super) struct Header {

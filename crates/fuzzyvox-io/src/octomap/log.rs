@@ -11,12 +11,12 @@
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::geometry::validate_pose;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
 
 use super::scan::ScanNode;
 use crate::bounded::ContentLines;
-use crate::error::{Error, Result};
-use crate::geometry::validate_pose;
 
 /// Reads an OctoMap scan log: a `NODE x y z roll pitch yaw` line starts each scan and is followed
 /// by its points, one `x y z` per line in the sensor frame. Fields are separated by whitespace;

@@ -11,21 +11,18 @@
 //! Only OctoMap's occupancy tree (`OcTree`) is read: other tree types (`ColorOcTree`,
 //! `OcTreeStamped`, ...) store more bytes per node and are refused by name.
 
-use std::path::Path;
-
-use crate::error::{FormatError, Result};
-use crate::write_atomic;
+use fuzzyvox_core::error::{FormatError, Result};
 
 use super::bt::{TREE_DEPTH, child_corner, voxel_key};
 use super::cursor::Cursor;
 use super::header::{decode_declared, parse_header};
-use super::tree::{OcTreeMap, OctreeLeaf};
+use super::leaf::OctreeLeaf;
 
 /// The start of the first line of every `.ot` file.
 pub(super) const OT_HEADER: &str = "# Octomap OcTree file";
 
 /// Bytes per node: a log-odds `f32` and the child byte.
-const NODE_BYTES: usize = 5;
+pub(super) const NODE_BYTES: usize = 5;
 
 /// A decoded `.ot` tree: its leaves in pre-order.
 pub(super) struct OtTree {
@@ -152,44 +149,4 @@ fn leaf(corner: [u32; 3], depth: u8, log_odds: f32) -> Result<OctreeLeaf, Format
         depth,
         log_odds,
     })
-}
-
-/// Writes a tree as an OctoMap `.ot` file with [`encode_ot`], atomically.
-pub fn write_ot(path: &Path, map: &OcTreeMap) -> Result<()> {
-    write_atomic(path, &encode_ot(map))
-}
-
-/// Encodes a tree as the bytes of an OctoMap `.ot` file: OctoMap's header, then every node in
-/// pre-order, inner nodes holding the largest log-odds of their children as OctoMap's
-/// `updateInnerOccupancy` leaves them. A `.bt` tree is written with its leaves at the clamping
-/// log-odds OctoMap gives them.
-pub fn encode_ot(map: &OcTreeMap) -> Vec<u8> {
-    use crate::map::VoxelMap;
-    let (masks, data) = map.nodes();
-    let values = map.node_values();
-    let resolution = map.resolution().size();
-    let mut bytes = format!(
-        "{OT_HEADER}\n# (feel free to add / change comments, but leave the first line as it \
-         is!)\n#\nid OcTree\nsize {}\nres {resolution}\ndata\n",
-        masks.len()
-    )
-    .into_bytes();
-    bytes.reserve(masks.len() * NODE_BYTES);
-    let mut stack = if masks.is_empty() {
-        vec![]
-    } else {
-        vec![0usize]
-    };
-    while let Some(node) = stack.pop() {
-        let mask = masks.get(node).copied().unwrap_or_default();
-        let value = values.get(node).copied().unwrap_or_default();
-        bytes.extend_from_slice(&value.to_le_bytes());
-        bytes.push(mask);
-        if mask != 0 {
-            let first = data.get(node).copied().unwrap_or_default() as usize;
-            // Last child first, so that the children pop in child order.
-            stack.extend((first..first + mask.count_ones() as usize).rev());
-        }
-    }
-    bytes
 }

@@ -1,10 +1,9 @@
 //! One scan of an OctoMap scan graph or log: a sensor pose and the points it measured.
 
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::geometry::validate_pose;
+use fuzzyvox_core::integrate::PointCloud;
 use nalgebra::{Isometry3, Point3};
-
-use crate::error::Result;
-use crate::geometry::validate_pose;
-use crate::integrate::PointCloud;
 
 /// One scan as OctoMap stores it: points in the sensor frame and the sensor's pose in the world.
 ///

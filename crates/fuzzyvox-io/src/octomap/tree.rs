@@ -14,42 +14,16 @@
 
 use std::path::Path;
 
+use fuzzyvox_core::error::{Error, FormatError, Result};
+use fuzzyvox_core::map::{LogOddsConfig, VoxelCounts, VoxelMap};
+use fuzzyvox_core::measures::{MeasureConfig, Memberships};
+use fuzzyvox_core::storage::{Resolution, VoxelKey};
+
 use super::bt::{
     BtMap, FILE_HEADER as BT_HEADER, KEY_OFFSET, TREE_DEPTH, child_corner, cube_keys, voxel_key,
 };
+use super::leaf::OctreeLeaf;
 use super::ot::{OT_HEADER, decode_ot};
-use crate::error::{Error, FormatError, Result};
-use crate::map::{LogOdds, LogOddsConfig, VoxelCounts, VoxelMap};
-use crate::measures::{MeasureConfig, Memberships};
-use crate::storage::{Resolution, VoxelKey};
-
-/// A leaf of an OctoMap tree with its occupancy log-odds: a cube of `side()³` voxels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OctreeLeaf {
-    /// The fuzzyvox key (OctoMap key − 32768) of the cube's lowest-corner voxel.
-    pub key: VoxelKey,
-    /// Tree depth, 0..=16: the leaf covers `2^(16 - depth)` voxels per side (one at depth 16).
-    pub depth: u8,
-    /// Occupancy log-odds, `ln(p / (1 - p))`.
-    pub log_odds: f32,
-}
-
-impl OctreeLeaf {
-    /// Voxels per side of the cube.
-    pub fn side(&self) -> u32 {
-        1 << (TREE_DEPTH - self.depth.min(TREE_DEPTH))
-    }
-
-    /// Voxels in the cube.
-    pub fn voxel_count(&self) -> u64 {
-        u64::from(self.side()).pow(3)
-    }
-
-    /// The memberships every voxel of the cube has: `μO = p`, `μE = 1 - p`.
-    pub fn memberships(&self) -> Memberships {
-        LogOdds(self.log_odds).memberships()
-    }
-}
 
 /// Which OctoMap file a tree was read from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,7 +65,7 @@ impl OctreeFormat {
 /// # Ok::<(), fuzzyvox_core::Error>(())
 /// ```
 ///
-/// The map is read-only: it is no [`VoxelMapMut`](crate::map::VoxelMapMut), so integrating
+/// The map is read-only: it is no [`VoxelMapMut`](fuzzyvox_core::map::VoxelMapMut), so integrating
 /// into it does not compile (start a fuzzy map from it with
 /// [`FuzzyMap::add_prior`](fuzzyvox_core::FuzzyMap::add_prior) instead):
 ///
@@ -152,8 +126,8 @@ impl OcTreeMap {
     pub fn from_bt(bt: &BtMap) -> Result<Self, FormatError> {
         let defaults = LogOddsConfig::new(bt.resolution)
             .map_err(|e| FormatError::Invalid(format!("resolution {} m: {e}", bt.resolution)))?;
-        let occupied = crate::map::logodds_of(defaults.clamp_max);
-        let free = crate::map::logodds_of(defaults.clamp_min);
+        let occupied = fuzzyvox_core::map::logodds_of(defaults.clamp_max);
+        let free = fuzzyvox_core::map::logodds_of(defaults.clamp_min);
         let leaves: Vec<OctreeLeaf> = bt
             .leaves
             .iter()

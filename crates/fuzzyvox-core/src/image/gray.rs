@@ -1,7 +1,7 @@
 //! Grayscale images for matching: one `f32` plane, `NaN` where a pixel has no value (outside the
 //! source image after rectification).
 
-use fuzzyvox_core::error::{Error, Result};
+use crate::error::{Error, Result};
 
 /// A grayscale image, row-major `f32` intensities in any range (census matching only compares
 /// pixels, so 0–255 and 0–1 work alike); `NaN` marks a pixel without a value.

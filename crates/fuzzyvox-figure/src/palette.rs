@@ -11,21 +11,15 @@
 //!
 //! Figures draw on a white background, so unknown space (light grey) is never mistaken for the
 //! page.
+//!
+//! The class colours ([`class_color`]) are defined in the core, beside the classes, because the
+//! PLY export (`fuzzyvox-io`) writes them too; they are re-exported here.
 
-use crate::measures::VoxelClass;
-
-/// The colour of each class, everywhere (figures, PLY export, viewer page).
-pub const fn class_color(class: VoxelClass) -> [u8; 3] {
-    match class {
-        VoxelClass::Occupied => [40, 40, 40],
-        VoxelClass::Free => [150, 210, 150],
-        VoxelClass::Ambiguous => [235, 140, 30],
-        VoxelClass::Unknown => UNKNOWN,
-    }
-}
+pub use fuzzyvox_core::class::class_color;
+use fuzzyvox_core::measures::VoxelClass;
 
 /// Unknown space: never observed, or observed without a class.
-pub const UNKNOWN: [u8; 3] = [215, 215, 215];
+pub const UNKNOWN: [u8; 3] = class_color(VoxelClass::Unknown);
 
 /// The figures' background, outside the mapped area.
 pub const BACKGROUND: [u8; 3] = [255, 255, 255];
