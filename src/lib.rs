@@ -7,9 +7,9 @@
 //! each depth measurement over the frustum and interval it really covers, and derives
 //! ambiguity, indeterminacy, safety and a class for every voxel.
 //!
-//! This crate is the facade: it re-exports the workspace's crates under one name and holds the
-//! `fuzzyvox` command (behind the default `cli` feature). The parts, each a crate usable on its
-//! own (see `docs/architecture.md`):
+//! This crate is the facade: it re-exports the workspace's library crates under one name (the
+//! `fuzzyvox` command is its own crate, `fuzzyvox-cli`, and adds nothing to a library user's
+//! build). The parts, each a crate usable on its own (see `docs/architecture.md`):
 //! - [`ops`]: t-norms, t-conorms, complements and hedges;
 //! - storage: sparse 8×8×8 blocks with `i32` keys ([`BlockGrid`], [`Resolution`]);
 //! - integration of [`PointCloud`]s (exact ray walk) and [`DepthFrame`]s with depth intervals

@@ -1,11 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-pub mod browser;
-pub mod octomap;
-
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use fuzzyvox::{DepthFrame, IntervalDepthImage, PinholeIntrinsics, PointCloud};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
@@ -111,27 +107,4 @@ pub fn wall_frame(position: Point3<f64>, wall_x: f64) -> DepthFrame {
     }
     let image = IntervalDepthImage::new(64, 48, near, values, far, confidence).unwrap();
     DepthFrame::new(k, pose, image).unwrap()
-}
-
-/// Runs the `fuzzyvox` binary built for these tests with `args`.
-pub fn fuzzyvox(args: &[&str]) -> Output {
-    // Built only with the `cli` feature (on by default); the tests that call this require it.
-    let Some(exe) = option_env!("CARGO_BIN_EXE_fuzzyvox") else {
-        panic!("the command-line tests need the `cli` feature");
-    };
-    Command::new(exe)
-        .args(args)
-        .output()
-        .expect("running fuzzyvox")
-}
-
-/// The one JSON object a command printed on standard output; fails the test, showing the
-/// command's standard error, when the command failed.
-pub fn json(output: &Output) -> serde_json::Value {
-    assert!(
-        output.status.success(),
-        "fuzzyvox failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
 }

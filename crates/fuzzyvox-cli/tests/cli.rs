@@ -566,7 +566,7 @@ fn printed_plan_examples_work() {
         map.to_str().unwrap(),
         "--json",
     ]));
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
     let mut examples = Vec::new();
     for doc in ["README.md", "docs/planning.md", "docs/cli.md"] {
         let found = plan_examples(&std::fs::read_to_string(root.join(doc)).unwrap());

@@ -1,5 +1,5 @@
-//! Command-line parsing and dispatch. Each command lives in its own file and only calls the
-//! library.
+//! The `fuzzyvox` command: argument parsing and output formatting over the library (the
+//! `fuzzyvox` facade crate). Each command lives in its own file; the work is the library's.
 
 mod demo;
 mod eval;
@@ -13,7 +13,7 @@ mod maps;
 mod merge;
 mod mono;
 mod plan;
-pub mod progress;
+mod progress;
 mod rgbd;
 mod simulate;
 mod stereo;
@@ -69,7 +69,7 @@ enum Command {
 }
 
 /// Parses the arguments, runs the command and reports errors with their causes.
-pub fn run() -> ExitCode {
+fn main() -> ExitCode {
     let cli = Cli::parse();
     progress::init_logging(cli.verbose);
     let result = match cli.command {
