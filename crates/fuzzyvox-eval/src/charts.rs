@@ -3,14 +3,15 @@
 
 use super::depth_stage::DepthStageErrors;
 use super::experiment::{DepthSample, ExperimentReport};
+use fuzzyvox_core::map::MapKind;
 use fuzzyvox_figure::chart::{BarPanel, Chart, LinePanel, Panel};
 
 /// Holes, spurious voxels, occupied F1 and flight success of the three models (`logodds`,
 /// `alpha`, `fuzzy`, in that order, those the experiment built).
 pub fn maps_chart(report: &ExperimentReport) -> Chart {
-    let maps: Vec<(&str, &super::MapReport)> = ["logodds", "alpha", "fuzzy"]
+    let maps: Vec<(&str, &super::MapReport)> = MapKind::ALL
         .into_iter()
-        .filter_map(|n| Some((n, report.maps.get(n)?)))
+        .filter_map(|kind| Some((kind.name(), report.maps.get(kind.name())?)))
         .collect();
     let names: Vec<String> = maps.iter().map(|(n, _)| n.to_string()).collect();
     let reports: Vec<&super::MapReport> = maps.iter().map(|(_, m)| *m).collect();
@@ -70,7 +71,7 @@ pub fn operators_chart(report: &ExperimentReport) -> Option<Chart> {
     let fuzzy: Vec<(&String, &super::MapReport)> = report
         .maps
         .iter()
-        .filter(|(name, _)| name.as_str() == "fuzzy" || name.starts_with("fuzzy:"))
+        .filter(|(name, _)| operator_of(name).is_some())
         .collect();
     if fuzzy.len() < 2 {
         return None;
@@ -83,7 +84,7 @@ pub fn operators_chart(report: &ExperimentReport) -> Option<Chart> {
         ),
         categories: fuzzy
             .iter()
-            .map(|(n, _)| match n.strip_prefix("fuzzy:") {
+            .map(|(n, _)| match operator_of(n).flatten() {
                 Some(op) => op.replace('-', " "),
                 None => "prob. sum".to_string(),
             })
@@ -156,4 +157,14 @@ pub fn depth_confidence_chart(scenario: &str, samples: &[DepthSample]) -> Option
         ],
         columns: 2,
     })
+}
+
+/// For a fuzzy map's name in an experiment (`fuzzy`, or `fuzzy:OP` for another operator), its
+/// operator (`None` for the default one); `None` for every other map.
+fn operator_of(name: &str) -> Option<Option<&str>> {
+    let rest = name.strip_prefix(MapKind::Fuzzy.name())?;
+    match rest.strip_prefix(':') {
+        Some(op) => Some(Some(op)),
+        None => rest.is_empty().then_some(None),
+    }
 }

@@ -18,7 +18,7 @@ use super::truth::{GroundTruth, gold_standard};
 use fuzzyvox_core::error::{Error, Result};
 use fuzzyvox_core::integrate::{DepthFrame, EvidenceModel, IntegrationOptions, IntervalDepthImage};
 use fuzzyvox_core::map::{
-    AlphaConfig, AlphaCutMap, AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap,
+    AnyMap, FuzzyConfig, FuzzyMap, LogOddsConfig, LogOddsMap, MapKind, MapOptions,
 };
 use fuzzyvox_core::ops::{Family, TConorm};
 use fuzzyvox_depth::{DepthParams, ForwardMotion, MatchMethod, ViewWindow};
@@ -244,25 +244,23 @@ pub fn run_experiment_with_progress(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<ExperimentOutput> {
     let mut window = ViewWindow::new(config.views)?;
-    let mut maps: Vec<(String, AnyMap)> = vec![
-        (
-            "logodds".into(),
-            AnyMap::LogOdds(LogOddsMap::new(LogOddsConfig::new(config.resolution)?)?),
-        ),
-        (
-            "alpha".into(),
-            AnyMap::Alpha(AlphaCutMap::new(AlphaConfig::new(config.resolution)?)?),
-        ),
-        (
-            "fuzzy".into(),
-            AnyMap::Fuzzy(FuzzyMap::new(
-                FuzzyConfig::new(config.resolution)?.with_evidence(config.evidence),
-            )?),
-        ),
-    ];
+    // One map of every kind, the fuzzy one with the experiment's evidence model.
+    let options = MapOptions {
+        evidence: config.evidence,
+        ..MapOptions::default()
+    };
+    let mut maps: Vec<(String, AnyMap)> = MapKind::ALL
+        .into_iter()
+        .map(|kind| {
+            Ok((
+                kind.name().to_string(),
+                kind.new_map_with(config.resolution, &options)?,
+            ))
+        })
+        .collect::<Result<_>>()?;
     for family in &config.operators {
         let operator = TConorm::new(*family)?;
-        let name = format!("fuzzy:{operator}");
+        let name = format!("{}:{operator}", MapKind::Fuzzy.name());
         if maps.iter().any(|(existing, _)| *existing == name) {
             return Err(Error::Duplicate(format!("the operator {operator}")));
         }
