@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use super::mapfile::{MapHeader, from_memory, read_checked, split};
-use crate::map::MapKind;
 use crate::error::{Error, Result};
+use crate::map::MapKind;
 use crate::map::{AlphaCutMap, AnyMap, FuzzyMap, LogOddsMap};
 
 impl AnyMap {

@@ -1,10 +1,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::mapfile;
-use crate::map::MapKind;
 use super::stored_blocks::{self, StoredBlock};
 use crate::error::{FormatError, Result};
 use crate::integrate::EvidenceModel;
+use crate::map::MapKind;
 use crate::map::{Accumulator, FuzzyConfig, FuzzyMap, Levels};
 use crate::measures::{MeasureConfig, Memberships};
 use crate::ops::TConorm;

@@ -1,9 +1,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::mapfile;
-use crate::map::MapKind;
 use super::stored_blocks::{self, StoredBlock};
 use crate::error::{FormatError, Result};
+use crate::map::MapKind;
 use crate::map::{AlphaConfig, AlphaCutMap, LogOdds, LogOddsConfig, LogOddsMap};
 
 #[derive(Serialize, Deserialize)]
