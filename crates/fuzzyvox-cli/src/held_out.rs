@@ -1,26 +1,19 @@
-//! What `rgbd` and `mono` share: the maps under test, built from the same depth images, and
-//! their check against held-out frames of sensor depth (ray casting, `within_2_voxels`).
+//! What `rgbd` and `mono` share: the options of the maps under test and of their check against
+//! held-out frames of sensor depth, the progress bars of a run, saving its maps and its table.
+//! The runs themselves are the library's (`fuzzyvox::eval::run_rgbd`, `run_mono`).
 
 use std::path::Path;
-use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use clap::{Args, ValueEnum};
-use fuzzyvox::eval::{DepthCheckConfig, DepthErrors};
-use fuzzyvox::{AnyMap, DepthFrame, Family, IntegrationOptions};
-use serde_json::{Value, json};
-use tracing::{debug, info};
+use clap::Args;
+use fuzzyvox::eval::{HeldOutConfig, HeldOutStage, MapCheckReport, PriorMap};
+use fuzzyvox::map::MapKind;
+use fuzzyvox::{AnyMap, Error, Family};
+use indicatif::ProgressBar;
+use tracing::info;
 
-use super::maps::{Evidence, Model, PriorArgs, new_map};
-
-/// Which maps a command builds (`--model`).
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Choice {
-    Fuzzy,
-    Logodds,
-    Alpha,
-    All,
-}
+use super::maps::{ModelArg, PriorArgs};
+use super::progress;
 
 /// The options of the maps under test and of their check against held-out frames.
 #[derive(Args)]
@@ -29,8 +22,8 @@ pub struct MapCheckArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub res: f64,
     /// Which maps to build and check, comma-separated, or all three.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
-    pub model: Vec<Choice>,
+    #[arg(long, value_parser = ModelArg::parser(), value_delimiter = ',', default_value = "all")]
+    pub model: Vec<ModelArg>,
     /// Hold out every K-th frame (the K-th, 2K-th, ...); the others build the maps.
     #[arg(long, default_value_t = 5)]
     pub holdout: usize,
@@ -56,158 +49,118 @@ pub struct MapCheckArgs {
 
 impl MapCheckArgs {
     /// The models asked for, in the order reports list them (log-odds, alpha, fuzzy).
-    pub fn models(&self) -> Vec<Model> {
-        Model::ALL
+    pub fn kinds(&self) -> Vec<MapKind> {
+        MapKind::ALL
             .into_iter()
-            .filter(|m| {
-                self.model.iter().any(|c| match c {
-                    Choice::Fuzzy => *m == Model::Fuzzy,
-                    Choice::Logodds => *m == Model::Logodds,
-                    Choice::Alpha => *m == Model::Alpha,
-                    Choice::All => true,
-                })
-            })
+            .filter(|kind| self.model.iter().any(|m| m.includes(*kind)))
             .collect()
     }
 
-    /// The ray-casting check's settings.
-    pub fn check(&self) -> anyhow::Result<DepthCheckConfig> {
-        DepthCheckConfig {
-            pixel_step: self.pixel_step,
-            max_range: self.cast_range,
-            stop_at_ambiguous: self.stop_at_ambiguous,
-        }
-        .validate()
-        .context("--pixel-step / --cast-range")
-    }
-
-    /// The operator, checked against the models.
-    pub fn family(&self) -> anyhow::Result<Family> {
-        let family: Family = self.op.parse().context("--op")?;
-        if !self.models().contains(&Model::Fuzzy) && self.op != "product" {
+    /// The library's settings, checked (errors name the flags).
+    pub fn config(&self) -> anyhow::Result<HeldOutConfig> {
+        let operator: Family = self.op.parse().context("--op")?;
+        let models = self.kinds();
+        if !models.contains(&MapKind::Fuzzy) && self.op != "product" {
             anyhow::bail!("--op applies to the fuzzy model only");
         }
-        self.prior.check_models(&self.models())?;
-        Ok(family)
-    }
-
-    /// A new, empty map per model asked for (the fuzzy one with its prior, when given).
-    pub fn maps(&self, family: Family) -> anyhow::Result<Vec<MapUnderTest>> {
-        self.models()
-            .into_iter()
-            .map(|model| {
-                let mut map = new_map(model, self.res, family, Evidence::Dual, self.cuts)?;
-                self.prior.apply(&mut map)?;
-                Ok(MapUnderTest {
-                    model,
-                    map,
-                    build: Duration::ZERO,
-                    predict: Duration::ZERO,
-                    errors: DepthErrors::default(),
-                })
-            })
-            .collect()
+        self.prior.check_models(&models)?;
+        let config = HeldOutConfig {
+            resolution: self.res,
+            models,
+            holdout: self.holdout,
+            pixel_step: self.pixel_step,
+            cast_range: self.cast_range,
+            stop_at_ambiguous: self.stop_at_ambiguous,
+            operator,
+            cuts: self.cuts,
+            prior: self.prior.prior.clone().map(|path| PriorMap {
+                path,
+                confidence: self.prior.prior_confidence,
+            }),
+        };
+        config.validate().map_err(flag_error)?;
+        Ok(config)
     }
 }
 
-/// One map under test, with its timings and its errors on held-out frames.
-pub struct MapUnderTest {
-    pub model: Model,
-    pub map: AnyMap,
-    pub build: Duration,
-    pub predict: Duration,
-    pub errors: DepthErrors,
+/// A library error, with the flag of the value it refuses when it names one.
+pub fn flag_error(error: Error) -> anyhow::Error {
+    let named = match &error {
+        Error::InvalidParameter { name, value, .. } => Some((*name, *value)),
+        Error::NonFinite { what, value } => Some((*what, *value)),
+        _ => None,
+    };
+    let flag = named.and_then(|(name, value)| {
+        let flag = match name {
+            "resolution" => "res",
+            "holdout" => "holdout",
+            "pixel_step" => "pixel-step",
+            "max_range" | "cast_range" => "cast-range",
+            "cuts" => "cuts",
+            "prior_confidence" | "prior confidence" => "prior-confidence",
+            "views" => "views",
+            "near" => "near",
+            "far" => "far",
+            "min_baseline" => "min-baseline",
+            _ => return None,
+        };
+        Some(format!("--{flag} {value}"))
+    });
+    match flag {
+        Some(flag) => anyhow::Error::new(error).context(flag),
+        None => error.into(),
+    }
 }
 
-/// Integrates one depth image into every map, timing each; `label` names it in errors.
-pub fn integrate_all(
-    maps: &mut [MapUnderTest],
-    frame: &DepthFrame,
-    options: &IntegrationOptions,
-    label: &str,
-) -> anyhow::Result<()> {
-    for entry in maps {
-        let started = Instant::now();
-        let stats = entry
-            .map
-            .as_map_mut()
-            .integrate_depth(frame, options)
-            .with_context(|| format!("integrating {label}"))?;
-        entry.build += started.elapsed();
-        debug!(
-            "{label} into the {} map: {} pixels, {} voxels updated",
-            entry.map.kind().name(),
-            stats.integrated,
-            stats.voxels_updated
-        );
-    }
-    Ok(())
+/// One progress bar per stage of a run, driven by its progress callback.
+pub struct StageBars {
+    quiet: bool,
+    current: Option<(HeldOutStage, ProgressBar)>,
 }
 
-/// Casts every map into one held-out frame of sensor depth and records the errors.
-pub fn check_all(
-    maps: &mut [MapUnderTest],
-    frame: &DepthFrame,
-    check: &DepthCheckConfig,
-    label: &str,
-) -> anyhow::Result<()> {
-    for entry in maps {
-        let started = Instant::now();
-        entry
-            .errors
-            .add_frame(entry.map.as_map(), frame, check)
-            .with_context(|| format!("checking {label}"))?;
-        entry.predict += started.elapsed();
+impl StageBars {
+    /// No bar yet; `quiet` hides them (as `--json` does).
+    pub fn new(quiet: bool) -> Self {
+        Self {
+            quiet,
+            current: None,
+        }
     }
-    Ok(())
+
+    /// The callback: `done` of `total` frames of `stage`.
+    pub fn update(&mut self, stage: HeldOutStage, done: usize, total: usize) {
+        if self.current.as_ref().map(|(s, _)| *s) != Some(stage) {
+            self.finish();
+            let bar = progress::bar(total as u64, stage.label(), self.quiet);
+            self.current = Some((stage, bar));
+        }
+        if let Some((_, bar)) = &self.current {
+            bar.set_position(done as u64);
+        }
+    }
+
+    /// Clears the last bar.
+    pub fn finish(&mut self) {
+        if let Some((_, bar)) = self.current.take() {
+            bar.finish_and_clear();
+        }
+    }
 }
 
 /// Saves every map as `DIR/MODEL.fvx`.
-pub fn save_all(maps: &[MapUnderTest], dir: &Path) -> anyhow::Result<()> {
+pub fn save_all(maps: &[AnyMap], dir: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    for entry in maps {
-        let path = dir.join(format!("{}.fvx", entry.map.kind().name()));
-        entry
-            .map
-            .save(&path)
+    for map in maps {
+        let path = dir.join(format!("{}.fvx", map.kind().name()));
+        map.save(&path)
             .with_context(|| format!("saving {}", path.display()))?;
         info!("saved {}", path.display());
     }
     Ok(())
 }
 
-/// One JSON report per map.
-pub fn reports(maps: &[MapUnderTest], family: Family, resolution: f64) -> Vec<Value> {
-    maps.iter()
-        .map(|entry| {
-            let view = entry.map.as_map();
-            let counts = view.counts();
-            let summary = entry.errors.summary(resolution);
-            json!({
-                "model": entry.map.kind().name(),
-                "operator": (entry.model == Model::Fuzzy).then(|| family.to_string()),
-                "build_seconds": entry.build.as_secs_f64(),
-                "predict_seconds": entry.predict.as_secs_f64(),
-                "occupied": counts.occupied,
-                "free": counts.free,
-                "ambiguous": counts.ambiguous,
-                "unknown": counts.unknown,
-                "memory_bytes": view.memory_bytes(),
-                "valid_pixels": summary.valid_pixels,
-                "predicted_pixels": summary.predicted_pixels,
-                "predicted": summary.predicted,
-                "median_abs_depth_error_m": summary.median_abs_depth_error_m,
-                "median_depth_error_m": summary.median_depth_error_m,
-                "within_2_voxels": summary.within_2_voxels,
-                "too_near": summary.too_near,
-                "too_far": summary.too_far,
-            })
-        })
-        .collect()
-}
-
 /// The reports as a table on standard output.
-pub fn print_table(reports: &[Value]) {
+pub fn print_table(reports: &[MapCheckReport]) {
     println!(
         "{:<8} {:>8} {:>10} {:>10} {:>15} {:>10} {:>9} {:>9} {:>9}",
         "model",
@@ -221,17 +174,18 @@ pub fn print_table(reports: &[Value]) {
         "occupied"
     );
     for r in reports {
+        let a = &r.agreement;
         println!(
             "{:<8} {:>8.2} {:>10.2} {:>10.3} {:>15.4} {:>10.3} {:>9.3} {:>9.3} {:>9}",
-            r["model"].as_str().unwrap_or("?"),
-            r["build_seconds"].as_f64().unwrap_or(f64::NAN),
-            r["predict_seconds"].as_f64().unwrap_or(f64::NAN),
-            r["predicted"].as_f64().unwrap_or(f64::NAN),
-            r["median_abs_depth_error_m"].as_f64().unwrap_or(f64::NAN),
-            r["within_2_voxels"].as_f64().unwrap_or(f64::NAN),
-            r["too_near"].as_f64().unwrap_or(f64::NAN),
-            r["too_far"].as_f64().unwrap_or(f64::NAN),
-            r["occupied"].as_u64().unwrap_or(0),
+            r.model.name(),
+            r.build_seconds,
+            r.predict_seconds,
+            a.predicted,
+            a.median_abs_depth_error_m,
+            a.within_2_voxels,
+            a.too_near,
+            a.too_far,
+            r.counts.occupied,
         );
     }
 }

@@ -3,9 +3,10 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
+use fuzzyvox::map::{MapKind, MapOptions};
 use fuzzyvox::{Family, IntegrationOptions, IntegrationStats};
 
-use super::maps::{Evidence, Model, PriorArgs, new_map};
+use super::maps::{Evidence, PriorArgs, kind_parser};
 use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
@@ -34,8 +35,8 @@ pub struct InsertArgs {
     #[arg(long, allow_negative_numbers = true)]
     max_range: Option<f64>,
     /// Map model.
-    #[arg(long, value_enum, default_value_t = Model::Fuzzy)]
-    model: Model,
+    #[arg(long, value_parser = kind_parser(), default_value_t = MapKind::Fuzzy)]
+    model: MapKind,
     /// Aggregation t-conorm of the fuzzy model as NAME[:PARAM], e.g. product, max, lukasiewicz,
     /// dombi:2, hamacher:0.5, yager:2, frank:3, einstein, aczel-alsina:2, schweizer-sklar:-1.
     #[arg(long, default_value = "product")]
@@ -59,20 +60,28 @@ pub struct InsertArgs {
 
 pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     let family: Family = args.op.parse().context("--op")?;
-    if args.model != Model::Fuzzy && args.op != "product" {
+    if args.model != MapKind::Fuzzy && args.op != "product" {
         bail!("--op applies to the fuzzy model only");
     }
-    if args.model != Model::Fuzzy && args.evidence != Evidence::Dual {
+    if args.model != MapKind::Fuzzy && args.evidence != Evidence::Dual {
         bail!("--evidence applies to the fuzzy model only");
     }
     args.prior.check_models(&[args.model])?;
-    let mut map = new_map(args.model, args.res, family, args.evidence, args.cuts)?;
+    let options = MapOptions {
+        operator: family,
+        evidence: args.evidence.model(),
+        cuts: args.cuts,
+    };
+    let mut map = args
+        .model
+        .new_map_with(args.res, &options)
+        .map_err(super::held_out::flag_error)?;
     let prior_voxels = args.prior.apply(&mut map)?;
     let reading = super::progress::spinner("reading the scans", args.json);
     let scans = super::input::read_scans(&args.cloud, args.origin)?;
     reading.finish_and_clear();
     tracing::info!("{} scan(s) read from {}", scans.len(), args.cloud.display());
-    if args.model == Model::Alpha && scans.iter().any(|s| s.confidence().is_none()) {
+    if args.model == MapKind::AlphaCut && scans.iter().any(|s| s.confidence().is_none()) {
         bail!(
             "the alpha model needs a confidence per point, and {} has none: give a text cloud \
              with `x y z confidence` lines (confidence in [0, 1]), or use --model logodds",
@@ -112,7 +121,7 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
             .with_context(|| format!("saving the map to {}", out.display()))?;
     }
     let model = map.kind().name();
-    let operator = (args.model == Model::Fuzzy).then(|| family.to_string());
+    let operator = (args.model == MapKind::Fuzzy).then(|| family.to_string());
     if args.json {
         return super::print_json(&json!({
             "points": points,

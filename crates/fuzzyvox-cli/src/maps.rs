@@ -1,26 +1,46 @@
-//! Building a new map of the kind a command asks for.
+//! The map models a command can build (`--model`, parsed through [`MapKind`]), the fuzzy
+//! map's evidence model and the prior map options.
 
 use anyhow::Context;
 use clap::ValueEnum;
-use fuzzyvox::{
-    AlphaConfig, AlphaCutMap, AnyMap, EvidenceKind, EvidenceModel, Family, FuzzyConfig, FuzzyMap,
-    LogOddsConfig, LogOddsMap, TConorm,
-};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use fuzzyvox::map::MapKind;
+use fuzzyvox::{AnyMap, EvidenceKind, EvidenceModel};
 
-/// The map models a command can build.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Model {
-    /// The dual-set fuzzy map.
-    Fuzzy,
-    /// The standard log-odds map (OctoMap semantics).
-    Logodds,
-    /// The alpha-cut log-odds map (needs per-point confidence).
-    Alpha,
+/// `--model` of the commands that build one map: a [`MapKind`] by its name.
+pub fn kind_parser() -> impl TypedValueParser<Value = MapKind> {
+    PossibleValuesParser::new(MapKind::ALL.map(MapKind::name)).try_map(|name| name.parse())
 }
 
-impl Model {
-    /// Every model, in the order reports list them.
-    pub const ALL: [Model; 3] = [Model::Logodds, Model::Alpha, Model::Fuzzy];
+/// One `--model` value of the commands that build several maps: a kind, or all of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelArg {
+    /// One kind.
+    Kind(MapKind),
+    /// Every kind (`all`).
+    All,
+}
+
+impl ModelArg {
+    /// Whether this value asks for `kind`.
+    pub fn includes(self, kind: MapKind) -> bool {
+        match self {
+            Self::Kind(k) => k == kind,
+            Self::All => true,
+        }
+    }
+
+    /// The parser of `--model` values: the kinds' names and `all`.
+    pub fn parser() -> impl TypedValueParser<Value = ModelArg> {
+        let names = MapKind::ALL.map(MapKind::name);
+        PossibleValuesParser::new(names.into_iter().chain(["all"])).try_map(|name| {
+            if name == "all" {
+                Ok(Self::All)
+            } else {
+                name.parse().map(Self::Kind)
+            }
+        })
+    }
 }
 
 /// How the fuzzy map turns measurements into evidence (`--evidence`).
@@ -44,8 +64,6 @@ impl Evidence {
     }
 }
 
-/// A new, empty map of `model` at `resolution` metres; `operator` and `evidence` apply to the
-/// fuzzy model and `cuts` to the alpha model.
 /// What colours a map's voxels in a PNG view or a viewer page (`--color`).
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ColorArg {
@@ -76,31 +94,6 @@ impl From<ColorArg> for fuzzyvox::figure::ViewColor {
     }
 }
 
-pub fn new_map(
-    model: Model,
-    resolution: f64,
-    operator: Family,
-    evidence: Evidence,
-    cuts: u32,
-) -> anyhow::Result<AnyMap> {
-    Ok(match model {
-        Model::Fuzzy => AnyMap::Fuzzy(FuzzyMap::new(
-            FuzzyConfig::new(resolution)
-                .context("--res")?
-                .with_operator(TConorm::new(operator)?)
-                .with_evidence(evidence.model()),
-        )?),
-        Model::Logodds => AnyMap::LogOdds(LogOddsMap::new(
-            LogOddsConfig::new(resolution).context("--res")?,
-        )?),
-        Model::Alpha => {
-            let mut config = AlphaConfig::new(resolution).context("--res")?;
-            config.cuts = cuts;
-            AnyMap::Alpha(AlphaCutMap::new(config).context("--cuts")?)
-        }
-    })
-}
-
 /// The prior map options of the commands that build maps (`--prior`, `--prior-confidence`).
 #[derive(clap::Args, Clone, Debug)]
 pub struct PriorArgs {
@@ -122,8 +115,8 @@ pub struct PriorArgs {
 
 impl PriorArgs {
     /// Refuses a prior for commands building other models than the fuzzy one.
-    pub fn check_models(&self, models: &[Model]) -> anyhow::Result<()> {
-        if self.prior.is_some() && models.iter().any(|m| *m != Model::Fuzzy) {
+    pub fn check_models(&self, models: &[MapKind]) -> anyhow::Result<()> {
+        if self.prior.is_some() && models.iter().any(|m| *m != MapKind::Fuzzy) {
             anyhow::bail!(
                 "--prior applies to the fuzzy model only (a log-odds or alpha-cut map has no \
                  confidence to give a prior): add --model fuzzy"

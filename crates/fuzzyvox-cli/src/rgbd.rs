@@ -2,14 +2,11 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::IntegrationOptions;
-use fuzzyvox::eval::HoldoutSplit;
+use fuzzyvox::eval::run_rgbd_on;
 use fuzzyvox::io::rgbd::RgbdFolder;
-use serde_json::json;
 use tracing::info;
 
-use super::held_out::{MapCheckArgs, check_all, integrate_all, print_table, reports, save_all};
-use super::progress;
+use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table, save_all};
 
 /// Map a folder of real RGB-D frames and check each map against frames it has not seen.
 ///
@@ -45,69 +42,39 @@ pub struct RgbdArgs {
 }
 
 pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
-    let family = args.maps.family()?;
-    let check = args.maps.check()?;
+    let config = args.maps.config()?;
     let folder = RgbdFolder::open(&args.dir)
         .with_context(|| format!("opening the RGB-D folder {}", args.dir.display()))?;
-    let holdout = args.maps.holdout;
-    let split = HoldoutSplit::new(folder.frames.len(), holdout)
-        .with_context(|| format!("--holdout {holdout} with {} frames", folder.frames.len()))?;
+    let mut bars = StageBars::new(args.json);
+    let run = run_rgbd_on(&folder, &config, &mut |stage, done, total| {
+        bars.update(stage, done, total)
+    })
+    .map_err(flag_error)
+    .with_context(|| format!("mapping {}", args.dir.display()))?;
+    bars.finish();
+    let report = &run.report;
     info!(
-        "{} frames in {}: {} build the maps, {} are held out",
-        folder.frames.len(),
+        "{} frames in {}: {} built the maps, {} were held out",
+        report.frames,
         args.dir.display(),
-        split.build.len(),
-        split.held_out.len()
+        report.build_frames,
+        report.held_out_frames
     );
-    let mut maps = args.maps.maps(family)?;
-
-    // Each frame is read once and fed to every map, so memory holds one frame at a time.
-    let read = |position: usize| {
-        let files = &folder.frames[position];
-        folder
-            .read_kinect_frame(position)
-            .with_context(|| format!("reading frame {}", files.depth.display()))
-    };
-    let label = |position: usize| format!("frame {}", folder.frames[position].number);
-    let options = IntegrationOptions::default();
-    let bar = progress::bar(split.build.len() as u64, "integrating", args.json);
-    for &position in &split.build {
-        integrate_all(&mut maps, &read(position)?, &options, &label(position))?;
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    let bar = progress::bar(split.held_out.len() as u64, "ray casting", args.json);
-    for &position in &split.held_out {
-        check_all(&mut maps, &read(position)?, &check, &label(position))?;
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
     if let Some(dir) = &args.save {
-        save_all(&maps, dir)?;
+        save_all(&run.maps, dir)?;
     }
-    let res = args.maps.res;
-    let reports = reports(&maps, family, res);
     if args.json {
-        return super::print_json(&json!({
-            "dir": args.dir,
-            "frames": folder.frames.len(),
-            "build_frames": split.build.len(),
-            "held_out_frames": split.held_out.len(),
-            "holdout": holdout,
-            "resolution": res,
-            "pixel_step": args.maps.pixel_step,
-            "cast_range": args.maps.cast_range,
-            "stop_at_ambiguous": args.maps.stop_at_ambiguous,
-            "maps": reports,
-        }));
+        return super::print_json(&serde_json::to_value(report)?);
     }
     println!(
-        "{}: {} frames, maps from {} at {res} m, checked on {} held-out frames (every {holdout}th)",
+        "{}: {} frames, maps from {} at {} m, checked on {} held-out frames (every {}th)",
         args.dir.display(),
-        folder.frames.len(),
-        split.build.len(),
-        split.held_out.len(),
+        report.frames,
+        report.build_frames,
+        report.resolution,
+        report.held_out_frames,
+        report.holdout,
     );
-    print_table(&reports);
+    print_table(&report.maps);
     Ok(())
 }

@@ -10,7 +10,8 @@
 //! [`run_experiment`] feeds identical depth-stage output to every map, measures each after
 //! every phase and, optionally, plans flights in each map and checks them against the true
 //! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
-//! ray-casting them into held-out frames.
+//! ray-casting them into held-out frames; [`run_rgbd`] and [`run_mono`] run the held-out
+//! experiments on real RGB-D folders and posed colour images.
 
 mod charts;
 pub mod closed_loop;
@@ -18,6 +19,7 @@ mod depth_stage;
 mod experiment;
 mod figures;
 mod flights;
+mod held_out;
 mod metrics;
 mod report;
 mod rgbd;
@@ -34,6 +36,10 @@ pub use flights::{
     BlockedByCounts, BlockingClass, Candidates, Connect, FailureCounts, FlightFailure,
     FlightOutcome, FlightQuery, FlightSummary, Obstacles, QueryConfig, draw_queries, path_collides,
     plan_queries, summarize,
+};
+pub use held_out::{
+    DepthStageReport, HeldOutConfig, HeldOutStage, MapCheckReport, MonoConfig, MonoReport, MonoRun,
+    MonoSeconds, PriorMap, RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};
