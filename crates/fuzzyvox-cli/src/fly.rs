@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use fuzzyvox::MapKind;
 use fuzzyvox::eval::QueryConfig;
 use fuzzyvox::eval::closed_loop::{ClosedLoopReport, draw_goals, fly_all, write_flight_figures};
@@ -10,6 +10,7 @@ use fuzzyvox::fly::FlyConfig;
 use fuzzyvox::plan::UnknownPolicy;
 
 use super::eval::ScenarioName;
+use super::maps::ModelArg;
 use super::plan::Unknown;
 
 /// Fly closed-loop flights: a simulated vehicle with one camera flies from a start to a goal
@@ -35,7 +36,7 @@ pub struct FlyArgs {
     #[arg(long, default_value_t = 5)]
     goals: usize,
     /// Maps to fly with: `all`, or a comma-separated list of fuzzy, logodds, alpha.
-    #[arg(long, value_delimiter = ',', default_value = "all")]
+    #[arg(long, value_delimiter = ',', default_value = "all", value_parser = ModelArg::parser())]
     model: Vec<ModelArg>,
     /// Camera views per depth image: 2 matches each frame against the previous one; N > 2
     /// adds earlier frames (multiple-baseline plane sweep).
@@ -90,30 +91,12 @@ pub struct FlyArgs {
     json: bool,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum ModelArg {
-    All,
-    Fuzzy,
-    Logodds,
-    Alpha,
-}
-
 pub fn run(args: FlyArgs) -> anyhow::Result<()> {
     let started = Instant::now();
-    let mut models = Vec::new();
-    for m in &args.model {
-        let add: &[MapKind] = match m {
-            ModelArg::All => &MapKind::ALL,
-            ModelArg::Fuzzy => &[MapKind::Fuzzy],
-            ModelArg::Logodds => &[MapKind::LogOdds],
-            ModelArg::Alpha => &[MapKind::AlphaCut],
-        };
-        for model in add {
-            if !models.contains(model) {
-                models.push(*model);
-            }
-        }
-    }
+    let models: Vec<MapKind> = MapKind::ALL
+        .into_iter()
+        .filter(|kind| args.model.iter().any(|m| m.includes(*kind)))
+        .collect();
     if args.goals == 0 {
         bail!("--goals must be at least 1");
     }

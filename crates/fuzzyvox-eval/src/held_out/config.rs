@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use crate::error::{Error, Result, finite};
-use crate::map::{AnyMap, MapKind, MapOptions};
-use crate::ops::Family;
 use crate::rgbd::DepthCheckConfig;
+use fuzzyvox_core::error::{Error, Result, finite};
+use fuzzyvox_core::map::{AnyMap, MapKind, MapOptions};
+use fuzzyvox_core::ops::Family;
 
 /// A prior map the fuzzy map starts from.
 #[derive(Clone, Debug, PartialEq)]
@@ -135,7 +135,7 @@ impl HeldOutConfig {
     /// when given).
     pub(super) fn new_maps(&self) -> Result<Vec<AnyMap>> {
         let prior = match &self.prior {
-            Some(prior) => Some((crate::io::load_map(&prior.path)?, prior.confidence)),
+            Some(prior) => Some((fuzzyvox_io::load_map(&prior.path)?, prior.confidence)),
             None => None,
         };
         self.kinds()

@@ -5,11 +5,11 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use crate::error::Result;
-use crate::integrate::{DepthFrame, IntegrationOptions};
-use crate::map::{AnyMap, MapKind, VoxelCounts};
-use crate::ops::Family;
 use crate::rgbd::{DepthAgreement, DepthCheckConfig, DepthErrors};
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::integrate::{DepthFrame, IntegrationOptions};
+use fuzzyvox_core::map::{AnyMap, MapKind, VoxelCounts};
+use fuzzyvox_core::ops::Family;
 
 /// One map's report: its model, timings, voxel counts, memory and its agreement with the
 /// held-out frames' sensor depth.

@@ -11,12 +11,12 @@ use super::maps::{MapCheckReport, MapUnderTest, check_all, integrate_all};
 use super::mono_config::MonoConfig;
 use super::stage::HeldOutStage;
 use crate::depth_stage::{DepthStageErrors, DepthStageSummary};
-use crate::error::Result;
-use crate::integrate::IntegrationOptions;
-use crate::io::posed::PosedFolder;
-use crate::io::rgbd::read_pose_txt;
-use crate::map::AnyMap;
 use crate::rgbd::HoldoutSplit;
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::integrate::IntegrationOptions;
+use fuzzyvox_core::map::AnyMap;
+use fuzzyvox_io::posed::PosedFolder;
+use fuzzyvox_io::rgbd::read_pose_txt;
 
 /// The depth stage's own depth against the sensor's, with its share of the time.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -84,7 +84,7 @@ pub struct MonoReport {
     pub seconds: MonoSeconds,
     /// Build frames per second of mapping time.
     pub frames_per_second: f64,
-    /// One report per map, in [`crate::map::MapKind::ALL`] order.
+    /// One report per map, in [`fuzzyvox_core::map::MapKind::ALL`] order.
     pub maps: Vec<MapCheckReport>,
 }
 

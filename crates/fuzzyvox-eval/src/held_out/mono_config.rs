@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use super::config::HeldOutConfig;
-use crate::depth::{DepthParams, DepthStream, PairCriteria};
-use crate::error::{Error, Result};
+use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_depth::{DepthParams, DepthStream, PairCriteria};
 
 /// The settings of [`super::run_mono`].
 #[derive(Clone, Debug, PartialEq)]

@@ -8,11 +8,11 @@ use serde::Serialize;
 use super::config::HeldOutConfig;
 use super::maps::{MapCheckReport, MapUnderTest, check_all, integrate_all};
 use super::stage::HeldOutStage;
-use crate::error::Result;
-use crate::integrate::IntegrationOptions;
-use crate::io::rgbd::RgbdFolder;
-use crate::map::AnyMap;
 use crate::rgbd::HoldoutSplit;
+use fuzzyvox_core::error::Result;
+use fuzzyvox_core::integrate::IntegrationOptions;
+use fuzzyvox_core::map::AnyMap;
+use fuzzyvox_io::rgbd::RgbdFolder;
 
 /// The report of [`run_rgbd`]: its JSON is what `fuzzyvox rgbd --json` prints.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -35,7 +35,7 @@ pub struct RgbdReport {
     pub cast_range: f64,
     /// Whether ambiguous voxels stopped rays.
     pub stop_at_ambiguous: bool,
-    /// One report per map, in [`crate::map::MapKind::ALL`] order.
+    /// One report per map, in [`fuzzyvox_core::map::MapKind::ALL`] order.
     pub maps: Vec<MapCheckReport>,
 }
 
