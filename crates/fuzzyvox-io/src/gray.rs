@@ -3,43 +3,30 @@
 
 use std::path::Path;
 
-use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::error::Result;
 use fuzzyvox_core::image::GrayImage;
+
+use crate::image_source::ImageSource;
 
 /// Reads a PNG or JPEG image file as a [`GrayImage`]. A missing file is [`Error::Io`]; any other
 /// format, or a damaged file, is [`Error::Parse`] naming the file.
+///
+/// [`Error::Io`]: fuzzyvox_core::error::Error::Io
+/// [`Error::Parse`]: fuzzyvox_core::error::Error::Parse
 pub fn read_gray_image(path: &Path) -> Result<GrayImage> {
-    let reader = image::ImageReader::open(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    gray_from(reader, path)
+    gray_from(ImageSource::File(path))
 }
 
 /// Decodes a PNG or JPEG image held in memory; see [`read_gray_image`]. Errors name the path
 /// `<memory>`.
 pub fn decode_gray_image(bytes: &[u8]) -> Result<GrayImage> {
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-    gray_from(reader, Path::new("<memory>"))
+    gray_from(ImageSource::Memory(bytes))
 }
 
-fn gray_from<R: std::io::BufRead + std::io::Seek>(
-    reader: image::ImageReader<R>,
-    path: &Path,
-) -> Result<GrayImage> {
-    let decoded = reader
-        .with_guessed_format()
-        .map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?
-        .decode()
-        .map_err(|e| Error::Parse {
-            path: path.to_path_buf(),
-            line: 0,
-            message: format!("not a readable image (PNG or JPEG): {e}"),
-        })?;
-    let rgb = decoded.to_rgb8();
+fn gray_from(source: ImageSource<'_>) -> Result<GrayImage> {
+    let rgb = source
+        .decode("not a readable image (PNG or JPEG)")?
+        .to_rgb8();
     let (width, height) = rgb.dimensions();
     GrayImage::from_rgb8(width, height, rgb.as_raw())
 }

@@ -11,6 +11,7 @@
 mod bounded;
 mod cloud_text;
 mod gray;
+mod image_source;
 mod load;
 pub mod middlebury;
 pub mod octomap;

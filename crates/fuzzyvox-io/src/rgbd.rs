@@ -9,6 +9,8 @@ use fuzzyvox_core::geometry::{PinholeIntrinsics, pose_from_matrix};
 use fuzzyvox_core::integrate::{DepthFrame, IntervalDepthImage};
 use nalgebra::{Isometry3, Matrix4};
 
+use crate::image_source::ImageSource;
+
 /// A depth image in metres, row-major; 0 where the sensor gave no reading.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DepthImage {
@@ -22,42 +24,26 @@ pub struct DepthImage {
 
 /// Reads a 16-bit PNG of depth in millimetres.
 pub fn read_depth_png_mm(path: &Path) -> Result<DepthImage> {
-    let reader = image::ImageReader::open(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    depth_png_from(reader, path)
+    depth_png_from(ImageSource::File(path))
 }
 
 /// Decodes a 16-bit PNG of depth in millimetres held in memory; see [`read_depth_png_mm`].
 /// Errors name the path `<memory>`.
 pub fn decode_depth_png_mm(bytes: &[u8]) -> Result<DepthImage> {
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-    depth_png_from(reader, Path::new("<memory>"))
+    depth_png_from(ImageSource::Memory(bytes))
 }
 
-fn depth_png_from<R: std::io::BufRead + std::io::Seek>(
-    reader: image::ImageReader<R>,
-    path: &Path,
-) -> Result<DepthImage> {
-    let format = |message: String| Error::Parse {
-        path: path.to_path_buf(),
-        line: 0,
-        message,
-    };
-    let decoded = reader
-        .with_guessed_format()
-        .map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?
-        .decode()
-        .map_err(|e| format(format!("not a readable image: {e}")))?;
+fn depth_png_from(source: ImageSource<'_>) -> Result<DepthImage> {
+    let decoded = source.decode("not a readable image")?;
     let image::DynamicImage::ImageLuma16(gray) = decoded else {
-        return Err(format(format!(
-            "expected a 16-bit grayscale depth image, found {:?}",
-            decoded.color()
-        )));
+        return Err(Error::Parse {
+            path: source.path().to_path_buf(),
+            line: 0,
+            message: format!(
+                "expected a 16-bit grayscale depth image, found {:?}",
+                decoded.color()
+            ),
+        });
     };
     let (width, height) = gray.dimensions();
     let depth = gray

@@ -105,16 +105,15 @@ mod tests {
     use crate::trajectory::look_at;
     use nalgebra::Point3;
 
+    /// Open ground, a wall centred at x = 12 m (16 m wide, 6 m high, turned 0.2 rad) and a
+    /// tree in front of it.
     fn scene() -> Scene {
+        let (wall_center, wall_half) = (Point3::new(12.0, 0.0, 3.0), Vector3::new(0.3, 8.0, 3.0));
+        let tree_base = Point3::new(6.0, 2.0, 0.0);
         let mut s = Scene::new();
         s.add_ground(0.0, 200.0)
-            .add_box(
-                Point3::new(12.0, 0.0, 3.0),
-                Vector3::new(0.3, 8.0, 3.0),
-                0.2,
-                SurfaceKind::Wall,
-            )
-            .add_tree(Point3::new(6.0, 2.0, 0.0), 0.25, 2.5, 1.2);
+            .add_box(wall_center, wall_half, 0.2, SurfaceKind::Wall)
+            .add_tree(tree_base, 0.25, 2.5, 1.2);
         s
     }
 

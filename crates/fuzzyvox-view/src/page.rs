@@ -324,13 +324,15 @@ mod tests {
     use fuzzyvox_core::map::{FuzzyConfig, FuzzyMap, VoxelMapMut};
     use nalgebra::Point3;
 
+    /// A wall at x = 2 m, y in [0, 2), z in [0, 1): one point per 0.1 m cell, seen from
+    /// (0.05, 1.05, 0.55).
     fn map() -> FuzzyMap {
-        let mut map = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
-        let points = (0..20)
-            .flat_map(|i| (0..10).map(move |j| (i, j)))
-            .map(|(i, j)| Point3::new(2.05, 0.05 + 0.1 * f64::from(i), 0.05 + 0.1 * f64::from(j)))
+        let cell_center = |n: i32| 0.05 + 0.1 * f64::from(n);
+        let wall = (0..20)
+            .flat_map(|i| (0..10).map(move |j| Point3::new(2.05, cell_center(i), cell_center(j))))
             .collect();
-        let cloud = PointCloud::new(Point3::new(0.05, 1.05, 0.55), points).unwrap();
+        let cloud = PointCloud::new(Point3::new(0.05, 1.05, 0.55), wall).unwrap();
+        let mut map = FuzzyMap::new(FuzzyConfig::new(0.1).unwrap()).unwrap();
         map.integrate_cloud(&cloud, &IntegrationOptions::default())
             .unwrap();
         map

@@ -25,7 +25,7 @@ use fuzzyvox_core::error::{Error, FormatError, Result};
 use fuzzyvox_core::storage::VoxelKey;
 
 use super::cursor::Cursor;
-use super::header::{decode_declared, parse_header};
+use super::walk::{TreeFormat, decode_tree_file, walk_children};
 
 /// Depth of OctoMap's tree: leaves at this depth are single voxels.
 pub(super) const TREE_DEPTH: u8 = 16;
@@ -148,44 +148,23 @@ pub fn read_bt(path: &Path) -> Result<BtMap> {
 /// Like OctoMap, it ignores unknown header keywords and any bytes after the tree. A root without
 /// children is, as OctoMap reads it, one occupied leaf covering all of space.
 pub fn decode_bt(bytes: &[u8]) -> Result<BtMap, FormatError> {
-    let header = parse_header(bytes, FILE_HEADER, "an OctoMap binary tree")?;
-    if header.id != "OcTree" && header.id != "1" {
-        return Err(FormatError::WrongKind {
-            expected: "OcTree",
-            found: header.id,
-        });
-    }
-    let data = bytes.get(header.data_start..).unwrap_or_default();
-    let mut map = BtMap {
-        resolution: header.resolution,
-        node_count: 0,
-        leaves: Vec::new(),
+    let format = TreeFormat {
+        first_line: FILE_HEADER,
+        name: "an OctoMap binary tree",
+        aliases: &["1"],
+        // Every node but the root is announced by two bits of its parent's two bytes.
+        most_nodes: |data_len| data_len.saturating_mul(4).saturating_add(1),
     };
-    // OctoMap reads no data at all for an empty tree.
-    if header.size == 0 {
-        return Ok(map);
-    }
-    // Every node but the root is announced by two bits of its parent's two bytes.
-    let most = data.len().saturating_mul(4).saturating_add(1);
-    map.node_count = decode_declared(header.size, data.len(), most, |declared| {
-        decode_tree(data, declared, &mut map.leaves)
-    })?;
-    Ok(map)
+    let tree = decode_tree_file(bytes, &format, decode_tree)?;
+    Ok(BtMap {
+        resolution: tree.resolution,
+        node_count: tree.node_count,
+        leaves: tree.leaves,
+    })
 }
 
-/// One inner node whose children are being visited.
-struct Frame {
-    depth: u8,
-    /// OctoMap key of the node's lowest corner.
-    corner: [u32; 3],
-    /// Two bits per child, child `i` at bits `2i, 2i + 1`.
-    children: u16,
-    next: u8,
-}
-
-/// Walks the tree iteratively (an explicit stack of at most 16 frames, so damaged data cannot
-/// recurse deeply), appends its leaves and returns the number of nodes. Stops with an error as
-/// soon as more than `declared` nodes are seen.
+/// Reads the tree (see [`walk_children`]), appends its leaves and returns the number of nodes.
+/// Stops with an error as soon as more than `declared` nodes are seen.
 fn decode_tree(
     data: &[u8],
     declared: usize,
@@ -198,61 +177,41 @@ fn decode_tree(
         leaves.push(leaf([0; 3], 0, true));
         return Ok(1);
     }
-    let mut nodes = 1usize;
-    let mut stack = Vec::with_capacity(usize::from(TREE_DEPTH));
-    stack.push(Frame {
-        depth: 0,
-        corner: [0; 3],
-        children: root,
-        next: 0,
-    });
-    while let Some(frame) = stack.last_mut() {
-        if frame.next == 8 {
-            stack.pop();
-            continue;
-        }
-        let i = u32::from(frame.next);
-        frame.next += 1;
-        let code = (frame.children >> (2 * i)) & 3;
-        if code == 0 {
-            continue;
-        }
-        nodes += 1;
-        if nodes > declared {
-            return Err(FormatError::Invalid(format!(
-                "the tree data holds more nodes than the {declared} the header declares"
-            )));
-        }
-        let depth = frame.depth + 1;
-        let corner = child_corner(frame.corner, frame.depth, i);
-        match code {
-            1 => leaves.push(leaf(corner, depth, false)),
-            2 => leaves.push(leaf(corner, depth, true)),
-            _ => {
-                if depth >= TREE_DEPTH {
-                    return Err(FormatError::Invalid(format!(
-                        "inner node at depth {depth} (byte {}): OctoMap trees have 16 levels",
-                        c.position()
-                    )));
-                }
-                let at = c.position();
-                let grandchildren = children(&mut c)?;
-                if grandchildren == 0 {
-                    // OctoMap never writes one: a node without children is written as a leaf.
-                    return Err(FormatError::Invalid(format!(
-                        "inner node at byte {at} has no children"
-                    )));
-                }
-                stack.push(Frame {
-                    depth,
-                    corner,
-                    children: grandchildren,
-                    next: 0,
-                });
+    let code = |children: u16, i: u32| (children >> (2 * i)) & 3;
+    walk_children(
+        root,
+        declared,
+        |children, i| code(children, i) != 0,
+        |child| {
+            let (depth, corner) = (child.depth, child.corner);
+            match code(child.siblings, child.index) {
+                1 => leaves.push(leaf(corner, depth, false)),
+                2 => leaves.push(leaf(corner, depth, true)),
+                _ => return inner_node(&mut c, depth).map(Some),
             }
-        }
+            Ok(None)
+        },
+    )
+}
+
+/// Reads the child bytes of an inner node at `depth`, which must be above the leaves' level and
+/// have children.
+fn inner_node(c: &mut Cursor<'_>, depth: u8) -> Result<u16, FormatError> {
+    if depth >= TREE_DEPTH {
+        return Err(FormatError::Invalid(format!(
+            "inner node at depth {depth} (byte {}): OctoMap trees have 16 levels",
+            c.position()
+        )));
     }
-    Ok(nodes)
+    let at = c.position();
+    let grandchildren = children(c)?;
+    if grandchildren == 0 {
+        // OctoMap never writes one: a node without children is written as a leaf.
+        return Err(FormatError::Invalid(format!(
+            "inner node at byte {at} has no children"
+        )));
+    }
+    Ok(grandchildren)
 }
 
 /// Reads a node's two child bytes as one `u16`, child `i` at bits `2i, 2i + 1`.

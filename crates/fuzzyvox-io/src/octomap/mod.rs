@@ -39,6 +39,7 @@ mod ot;
 mod ot_write;
 mod scan;
 mod tree;
+mod walk;
 
 pub use bt::{BtLeaf, BtMap, decode_bt, read_bt};
 pub use bt_write::{encode_bt, write_bt, write_bt_max_likelihood};

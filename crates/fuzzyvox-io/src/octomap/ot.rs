@@ -13,10 +13,10 @@
 
 use fuzzyvox_core::error::{FormatError, Result};
 
-use super::bt::{TREE_DEPTH, child_corner, voxel_key};
+use super::bt::{TREE_DEPTH, voxel_key};
 use super::cursor::Cursor;
-use super::header::{decode_declared, parse_header};
 use super::leaf::OctreeLeaf;
+use super::walk::{DecodedTree, TreeFormat, decode_tree_file, walk_children};
 
 /// The start of the first line of every `.ot` file.
 pub(super) const OT_HEADER: &str = "# Octomap OcTree file";
@@ -24,52 +24,24 @@ pub(super) const OT_HEADER: &str = "# Octomap OcTree file";
 /// Bytes per node: a log-odds `f32` and the child byte.
 pub(super) const NODE_BYTES: usize = 5;
 
-/// A decoded `.ot` tree: its leaves in pre-order.
-pub(super) struct OtTree {
-    pub(super) resolution: f64,
-    pub(super) node_count: usize,
-    pub(super) leaves: Vec<OctreeLeaf>,
-}
-
 /// Decodes the bytes of a `.ot` file.
 ///
 /// Checks, each a [`FormatError`]: the first line, an `id` of `OcTree`, a `size` and a finite
 /// positive `res`, the declared size against what the data can hold (before decoding), the tree
 /// depth (16 levels), truncation, finite leaf values, and the number of nodes read against
 /// `size`. Like OctoMap, it ignores unknown header keywords and any bytes after the tree.
-pub(super) fn decode_ot(bytes: &[u8]) -> Result<OtTree, FormatError> {
-    let header = parse_header(bytes, OT_HEADER, "an OctoMap tree (.ot)")?;
-    if header.id != "OcTree" {
-        return Err(FormatError::WrongKind {
-            expected: "OcTree",
-            found: header.id,
-        });
-    }
-    let data = bytes.get(header.data_start..).unwrap_or_default();
-    let mut tree = OtTree {
-        resolution: header.resolution,
-        node_count: 0,
-        leaves: Vec::new(),
+pub(super) fn decode_ot(bytes: &[u8]) -> Result<DecodedTree<OctreeLeaf>, FormatError> {
+    let format = TreeFormat {
+        first_line: OT_HEADER,
+        name: "an OctoMap tree (.ot)",
+        aliases: &[],
+        most_nodes: |data_len| data_len / NODE_BYTES,
     };
-    if header.size == 0 {
-        return Ok(tree);
-    }
-    tree.node_count = decode_declared(header.size, data.len(), data.len() / NODE_BYTES, |n| {
-        decode_tree(data, n, &mut tree.leaves)
-    })?;
-    Ok(tree)
+    decode_tree_file(bytes, &format, decode_tree)
 }
 
-/// One inner node whose children are being visited.
-struct Frame {
-    depth: u8,
-    corner: [u32; 3],
-    children: u8,
-    next: u8,
-}
-
-/// Walks the tree with an explicit stack (at most 16 frames), appends its leaves and returns
-/// the number of nodes; stops as soon as more than `declared` nodes are seen.
+/// Reads the tree (see [`walk_children`]), appends its leaves and returns the number of nodes;
+/// stops as soon as more than `declared` nodes are seen.
 fn decode_tree(
     data: &[u8],
     declared: usize,
@@ -81,50 +53,26 @@ fn decode_tree(
         leaves.push(leaf([0; 3], 0, value)?);
         return Ok(1);
     }
-    let mut nodes = 1usize;
-    let mut stack = Vec::with_capacity(usize::from(TREE_DEPTH));
-    stack.push(Frame {
-        depth: 0,
-        corner: [0; 3],
+    walk_children(
         children,
-        next: 0,
-    });
-    while let Some(frame) = stack.last_mut() {
-        if frame.next == 8 {
-            stack.pop();
-            continue;
-        }
-        let i = u32::from(frame.next);
-        frame.next += 1;
-        if frame.children & (1 << i) == 0 {
-            continue;
-        }
-        nodes += 1;
-        if nodes > declared {
-            return Err(FormatError::Invalid(format!(
-                "the tree data holds more nodes than the {declared} the header declares"
-            )));
-        }
-        let depth = frame.depth + 1;
-        let corner = child_corner(frame.corner, frame.depth, i);
-        let at = c.position();
-        let (value, children) = node(&mut c)?;
-        if children == 0 {
-            leaves.push(leaf(corner, depth, value)?);
-        } else if depth >= TREE_DEPTH {
-            return Err(FormatError::Invalid(format!(
-                "node at byte {at} has children at depth {depth}: OctoMap trees have 16 levels"
-            )));
-        } else {
-            stack.push(Frame {
-                depth,
-                corner,
-                children,
-                next: 0,
-            });
-        }
-    }
-    Ok(nodes)
+        declared,
+        |children: u8, i| children & (1 << i) != 0,
+        |child| {
+            let (depth, corner) = (child.depth, child.corner);
+            let at = c.position();
+            let (value, children) = node(&mut c)?;
+            if children == 0 {
+                leaves.push(leaf(corner, depth, value)?);
+                Ok(None)
+            } else if depth >= TREE_DEPTH {
+                Err(FormatError::Invalid(format!(
+                    "node at byte {at} has children at depth {depth}: OctoMap trees have 16 levels"
+                )))
+            } else {
+                Ok(Some(children))
+            }
+        },
+    )
 }
 
 /// Reads one node: its log-odds and its child byte.
