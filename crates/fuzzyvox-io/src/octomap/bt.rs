@@ -25,29 +25,8 @@ use fuzzyvox_core::error::{Error, FormatError, Result};
 use fuzzyvox_core::storage::VoxelKey;
 
 use super::cursor::Cursor;
+use super::keys::{TREE_DEPTH, voxel_key};
 use super::walk::{TreeFormat, decode_tree_file, walk_children};
-
-/// Depth of OctoMap's tree: leaves at this depth are single voxels.
-pub(super) const TREE_DEPTH: u8 = 16;
-/// OctoMap key of the voxel fuzzyvox calls key 0 (OctoMap keys are `floor(p / res) + 2^15`).
-pub(super) const KEY_OFFSET: i32 = 1 << 15;
-/// The OctoMap key of the lowest corner of child `child` (x in bit 0, y in 1, z in 2) of the node
-/// at `depth` whose lowest corner is `parent`.
-pub(super) fn child_corner(parent: [u32; 3], depth: u8, child: u32) -> [u32; 3] {
-    let half = 1u32 << (TREE_DEPTH - 1 - depth.min(TREE_DEPTH - 1));
-    let offset = |axis: u32| ((child >> axis) & 1) * half;
-    [
-        parent[0] + offset(0),
-        parent[1] + offset(1),
-        parent[2] + offset(2),
-    ]
-}
-
-/// The fuzzyvox key of an OctoMap key (corners are below 2^16, so the conversion is exact).
-pub(super) fn voxel_key(octomap: [u32; 3]) -> VoxelKey {
-    let ours = |k: u32| k as i32 - KEY_OFFSET;
-    VoxelKey::new(ours(octomap[0]), ours(octomap[1]), ours(octomap[2]))
-}
 
 /// The start of the first line of every `.bt` file.
 pub(super) const FILE_HEADER: &str = "# Octomap OcTree binary file";
@@ -244,6 +223,7 @@ fn deinterleave(m: u64) -> [i32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::octomap::keys::KEY_OFFSET;
 
     fn file(header: &str, data: &[u8]) -> Vec<u8> {
         let mut bytes = format!("{FILE_HEADER}\n{header}data\n").into_bytes();

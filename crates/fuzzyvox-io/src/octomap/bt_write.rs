@@ -6,7 +6,8 @@ use fuzzyvox_core::error::{Error, Result, finite};
 use fuzzyvox_core::file::write_atomic;
 use fuzzyvox_core::storage::VoxelKey;
 
-use super::bt::{FILE_HEADER, KEY_OFFSET, TREE_DEPTH};
+use super::bt::FILE_HEADER;
+use super::keys::{KEY_OFFSET, TREE_DEPTH};
 
 /// Two bits per child, every child a free leaf / every child an occupied leaf.
 const ALL_FREE: u16 = 0x5555;

@@ -5,7 +5,7 @@ use fuzzyvox_core::map::LogOdds;
 use fuzzyvox_core::measures::Memberships;
 use fuzzyvox_core::storage::VoxelKey;
 
-use super::bt::TREE_DEPTH;
+use super::keys::TREE_DEPTH;
 
 /// A leaf of an OctoMap tree with its occupancy log-odds: a cube of `side()³` voxels.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -33,6 +33,7 @@ mod bt_write;
 mod cursor;
 mod graph;
 mod header;
+mod keys;
 mod leaf;
 mod log;
 mod ot;

@@ -13,8 +13,8 @@
 
 use fuzzyvox_core::error::{FormatError, Result};
 
-use super::bt::{TREE_DEPTH, voxel_key};
 use super::cursor::Cursor;
+use super::keys::{TREE_DEPTH, voxel_key};
 use super::leaf::OctreeLeaf;
 use super::walk::{DecodedTree, TreeFormat, decode_tree_file, walk_children};
 

@@ -19,9 +19,8 @@ use fuzzyvox_core::map::{LogOddsConfig, VoxelCounts, VoxelMap};
 use fuzzyvox_core::measures::{MeasureConfig, Memberships};
 use fuzzyvox_core::storage::{Resolution, VoxelKey};
 
-use super::bt::{
-    BtMap, FILE_HEADER as BT_HEADER, KEY_OFFSET, TREE_DEPTH, child_corner, cube_keys, voxel_key,
-};
+use super::bt::{BtMap, FILE_HEADER as BT_HEADER, cube_keys};
+use super::keys::{KEY_OFFSET, TREE_DEPTH, child_corner, voxel_key};
 use super::leaf::OctreeLeaf;
 use super::ot::{OT_HEADER, decode_ot};
 

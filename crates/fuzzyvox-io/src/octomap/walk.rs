@@ -4,8 +4,8 @@
 
 use fuzzyvox_core::error::FormatError;
 
-use super::bt::{TREE_DEPTH, child_corner};
 use super::header::{decode_declared, parse_header};
+use super::keys::{TREE_DEPTH, child_corner};
 
 /// The tree type both readers accept (`.bt` readers also accept its deprecated form `1`).
 const OCTREE_ID: &str = "OcTree";
