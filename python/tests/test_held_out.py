@@ -23,9 +23,9 @@ def few_frames(tmp_path: Path, count: int) -> Path:
     source = data_file("rgbd-7scenes-redkitchen/camera-intrinsics.txt").parent
     folder = tmp_path / "frames"
     folder.mkdir()
+    numbers = sorted({p.name.split(".")[0] for p in source.glob("frame-*")})[:count]
     for path in sorted(source.iterdir()):
-        number = path.name.split(".")[0].removeprefix("frame-")
-        if not path.name.startswith("frame-") or int(number) < count:
+        if not path.name.startswith("frame-") or path.name.split(".")[0] in numbers:
             (folder / path.name).symlink_to(path)
     return folder
 
