@@ -106,7 +106,7 @@ pub fn rgbd<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let config = held_out_config(
         res,
-        &model,
+        model,
         holdout,
         pixel_step,
         cast_range,
