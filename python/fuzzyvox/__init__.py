@@ -5,7 +5,8 @@ and interval depth images given as numpy arrays, answer queries on arrays of poi
 save and load native ``.fvx`` files, export OctoMap ``.bt`` and PLY files, and pickle through
 their native bytes (so they travel between processes, for example Dask workers).
 :func:`plan` runs A* through any map; :class:`Scenario`, :class:`GroundTruth` and
-:func:`run_experiment` run the simulated scenarios and measure maps against their truth.
+:func:`run_experiment` run the simulated scenarios and measure maps against their truth;
+:func:`rgbd` and :func:`mono` run the held-out experiments on real data.
 
 Voxel classes are returned as int8 codes, in the order of :data:`CLASS_NAMES`:
 0 occupied, 1 free, 2 ambiguous, 3 unknown (or as names with ``classes(points, names=True)``).
@@ -26,10 +27,12 @@ from ._native import (
     __version__,
     from_bytes,
     load,
+    mono,
     operators,
     parse_operator,
     plan,
     read_cloud,
+    rgbd,
     run_experiment,
 )
 
@@ -62,9 +65,11 @@ __all__ = [
     "__version__",
     "from_bytes",
     "load",
+    "mono",
     "operators",
     "parse_operator",
     "plan",
     "read_cloud",
+    "rgbd",
     "run_experiment",
 ]

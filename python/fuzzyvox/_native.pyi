@@ -230,3 +230,38 @@ def run_experiment(
     operators: Optional[Sequence[str]] = None,
     seed: int = 1,
 ) -> Experiment: ...
+
+def rgbd(
+    dir: _Path,
+    res: float,
+    model: str = "all",
+    holdout: int = 5,
+    pixel_step: int = 1,
+    cast_range: float = 8.0,
+    stop_at_ambiguous: bool = False,
+    op: str = "product",
+    cuts: int = 10,
+    prior: Optional[_Path] = None,
+    prior_confidence: float = 0.5,
+    save: Optional[_Path] = None,
+) -> dict[str, Any]: ...
+def mono(
+    dir: _Path,
+    res: float,
+    model: str = "all",
+    holdout: int = 5,
+    pixel_step: int = 1,
+    cast_range: float = 8.0,
+    stop_at_ambiguous: bool = False,
+    op: str = "product",
+    cuts: int = 10,
+    prior: Optional[_Path] = None,
+    prior_confidence: float = 0.5,
+    views: int = 2,
+    trajectory: Optional[_Path] = None,
+    extrinsics: Optional[_Path] = None,
+    near: float = 0.3,
+    far: float = 8.0,
+    min_baseline: float = 0.05,
+    out: Optional[_Path] = None,
+) -> dict[str, Any]: ...

@@ -1,7 +1,8 @@
 //! The native half of the `fuzzyvox` Python package (`fuzzyvox._native`): the three maps,
 //! integration of point clouds and interval depth images from numpy arrays, queries, native
 //! files and exports, the operator catalogue, planning, and the simulated scenarios with their
-//! ground truth. `python/fuzzyvox/__init__.py` re-exports it; `docs/python.md` is the tour.
+//! ground truth, and the held-out experiments on real data (`rgbd`, `mono`).
+//! `python/fuzzyvox/__init__.py` re-exports it; `docs/python.md` is the tour.
 //!
 //! Every long call releases the GIL (`Python::detach`); input arrays are read in place where
 //! their layout allows; fuzzyvox errors become `fuzzyvox.FuzzyvoxError` subclasses carrying the
@@ -9,6 +10,7 @@
 
 mod arrays;
 mod errors;
+mod held_out;
 mod maps;
 mod plan;
 mod rgbd;
@@ -165,6 +167,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::run_experiment, m)?)?;
+    m.add_function(wrap_pyfunction!(held_out::rgbd, m)?)?;
+    m.add_function(wrap_pyfunction!(held_out::mono, m)?)?;
     m.add(
         "CLASS_NAMES",
         pyo3::types::PyTuple::new(m.py(), maps::CLASS_NAMES)?,

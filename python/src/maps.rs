@@ -52,15 +52,6 @@ fn stats_dict<'py>(py: Python<'py>, stats: &IntegrationStats) -> PyResult<Bound<
     Ok(d)
 }
 
-/// The short name of a map's kind.
-pub fn kind_name(map: &AnyMap) -> &'static str {
-    match map {
-        AnyMap::Fuzzy(_) => "fuzzy",
-        AnyMap::LogOdds(_) => "logodds",
-        AnyMap::Alpha(_) => "alpha",
-    }
-}
-
 /// A Rust map as the Python object of its class.
 pub fn wrap(py: Python<'_>, map: AnyMap) -> PyResult<Py<PyAny>> {
     Ok(match map {
@@ -134,7 +125,7 @@ macro_rules! map_class {
             /// The map's kind: ``"fuzzy"``, ``"logodds"`` or ``"alpha"``.
             #[getter]
             fn kind(&self) -> &'static str {
-                kind_name(&self.map)
+                self.map.kind().name()
             }
 
             /// Integrates one point cloud as one scan and returns its statistics

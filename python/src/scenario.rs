@@ -17,7 +17,10 @@ use crate::errors::{OrRaise, invalid};
 use crate::maps::{with_map, wrap};
 
 /// A JSON value as Python objects (through the standard library's `json`).
-fn json_to_py<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn json_to_py<'py>(
+    py: Python<'py>,
+    value: &impl serde::Serialize,
+) -> PyResult<Bound<'py, PyAny>> {
     let text = serde_json::to_string(value).map_err(|e| invalid(e.to_string()))?;
     py.import("json")?.call_method1("loads", (text,))
 }

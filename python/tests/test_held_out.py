@@ -1,0 +1,83 @@
+"""The held-out experiments on real data (needs FUZZYVOX_DATA): ``fuzzyvox.rgbd`` and
+``fuzzyvox.mono`` return the keys the command's ``--json`` prints, for the same settings."""
+
+import json
+import subprocess
+from pathlib import Path
+
+import pytest
+
+import fuzzyvox
+
+from conftest import data_file
+
+#: The command, built by ``cargo build --release --bin fuzzyvox`` (CI builds it before pytest).
+BINARY = Path(__file__).resolve().parents[2] / "target" / "release" / "fuzzyvox"
+
+#: Cheap settings: every 8th pixel checked, coarse voxels.
+SETTINGS = {"res": 0.1, "pixel_step": 8}
+
+
+def few_frames(tmp_path: Path, count: int) -> Path:
+    """The first `count` frames of the 7-Scenes sequence, linked into a folder of their own."""
+    source = data_file("rgbd-7scenes-redkitchen/camera-intrinsics.txt").parent
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    numbers = sorted({p.name.split(".")[0] for p in source.glob("frame-*")})[:count]
+    for path in sorted(source.iterdir()):
+        if not path.name.startswith("frame-") or path.name.split(".")[0] in numbers:
+            (folder / path.name).symlink_to(path)
+    return folder
+
+
+def command_json(command: str, folder: Path) -> dict:
+    """`fuzzyvox COMMAND --dir FOLDER ... --json` with the same settings."""
+    if not BINARY.is_file():
+        pytest.fail(f"{BINARY} is missing: build it with `cargo build --release --bin fuzzyvox`")
+    args = [str(BINARY), command, "--dir", str(folder), "--json"]
+    for key, value in SETTINGS.items():
+        args += ["--" + key.replace("_", "-"), str(value)]
+    done = subprocess.run(args, capture_output=True, text=True, check=True)
+    return json.loads(done.stdout)
+
+
+def key_tree(value):
+    """The keys of a JSON value, recursively (lists by element)."""
+    if isinstance(value, dict):
+        return {k: key_tree(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [key_tree(v) for v in value]
+    return None
+
+
+def test_rgbd_report_has_the_commands_keys(tmp_path):
+    folder = few_frames(tmp_path, 15)
+    report = fuzzyvox.rgbd(folder, **SETTINGS)
+    assert key_tree(report) == key_tree(command_json("rgbd", folder))
+    assert [m["model"] for m in report["maps"]] == ["logodds", "alpha", "fuzzy"]
+    assert [m["operator"] for m in report["maps"]] == [None, None, "product"]
+    assert report["frames"] == 15 and report["held_out_frames"] == 3
+    assert 0.0 < report["maps"][2]["within_2_voxels"] <= 1.0
+
+
+def test_mono_report_has_the_commands_keys(tmp_path):
+    folder = few_frames(tmp_path, 10)
+    report = fuzzyvox.mono(folder, **SETTINGS)
+    assert key_tree(report) == key_tree(command_json("mono", folder))
+    assert report["depth_range"] == [0.3, 8.0]
+    assert set(report["seconds"]) == {"read", "depth", "integrate", "check"}
+
+
+def test_held_out_runs_refuse_bad_settings(tmp_path):
+    folder = few_frames(tmp_path, 10)
+    with pytest.raises(fuzzyvox.InvalidInputError, match="holdout"):
+        fuzzyvox.rgbd(folder, 0.1, holdout=1)
+    with pytest.raises(fuzzyvox.InvalidInputError, match="map model"):
+        fuzzyvox.rgbd(folder, 0.1, model="octree")
+    with pytest.raises(fuzzyvox.InvalidInputError, match="fuzzy model only"):
+        fuzzyvox.rgbd(folder, 0.1, model="logodds", op="max")
+    with pytest.raises(fuzzyvox.InvalidInputError, match="near < far"):
+        fuzzyvox.mono(folder, 0.1, near=5.0, far=2.0)
+    report = fuzzyvox.rgbd(folder, 0.1, model="fuzzy", pixel_step=16, save=tmp_path / "maps")
+    assert [m["model"] for m in report["maps"]] == ["fuzzy"]
+    assert fuzzyvox.load(tmp_path / "maps" / "fuzzy.fvx").kind == "fuzzy"
