@@ -2,7 +2,9 @@
 name everything the module defines)."""
 
 from os import PathLike
-from typing import Any, Literal, Optional, Sequence, Union, final, overload
+from typing import Any, Literal, Optional, Sequence, TypedDict, Union, final, overload
+
+from typing_extensions import Unpack
 
 import numpy as np
 import numpy.typing as npt
@@ -231,37 +233,30 @@ def run_experiment(
     seed: int = 1,
 ) -> Experiment: ...
 
-def rgbd(
-    dir: _Path,
-    res: float,
-    model: str = "all",
-    holdout: int = 5,
-    pixel_step: int = 1,
-    cast_range: float = 8.0,
-    stop_at_ambiguous: bool = False,
-    op: str = "product",
-    cuts: int = 10,
-    prior: Optional[_Path] = None,
-    prior_confidence: float = 0.5,
-    save: Optional[_Path] = None,
-) -> dict[str, Any]: ...
-def mono(
-    dir: _Path,
-    res: float,
-    model: str = "all",
-    holdout: int = 5,
-    pixel_step: int = 1,
-    cast_range: float = 8.0,
-    stop_at_ambiguous: bool = False,
-    op: str = "product",
-    cuts: int = 10,
-    prior: Optional[_Path] = None,
-    prior_confidence: float = 0.5,
-    views: int = 2,
-    trajectory: Optional[_Path] = None,
-    extrinsics: Optional[_Path] = None,
-    near: float = 0.3,
-    far: float = 8.0,
-    min_baseline: float = 0.05,
-    out: Optional[_Path] = None,
-) -> dict[str, Any]: ...
+class HeldOutOptions(TypedDict, total=False):
+    """The options :func:`rgbd` and :func:`mono` share: the commands' flags."""
+
+    model: str  # "all" (default), a map kind's name, or comma-separated names
+    holdout: int  # 5
+    pixel_step: int  # 1
+    cast_range: float  # 8.0
+    stop_at_ambiguous: bool  # False
+    op: str  # "product"
+    cuts: int  # 10
+    prior: Optional[_Path]  # None
+    prior_confidence: float  # 0.5
+
+class RgbdOptions(HeldOutOptions, total=False):
+    save: Optional[_Path]
+
+class MonoOptions(HeldOutOptions, total=False):
+    views: int  # 2
+    trajectory: Optional[_Path]
+    extrinsics: Optional[_Path]
+    near: float  # 0.3
+    far: float  # 8.0
+    min_baseline: float  # 0.05
+    out: Optional[_Path]
+
+def rgbd(dir: _Path, res: float, **options: Unpack[RgbdOptions]) -> dict[str, Any]: ...
+def mono(dir: _Path, res: float, **options: Unpack[MonoOptions]) -> dict[str, Any]: ...

@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use fuzzyvox_core::{AnyMap, Family, MapKind};
 use fuzzyvox_eval::{HeldOutConfig, MonoConfig, PriorMap, run_mono, run_rgbd};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::errors::{OrRaise, invalid};
 use crate::scenario::json_to_py;
@@ -24,36 +26,83 @@ fn kinds_of(model: &str) -> PyResult<Vec<MapKind>> {
     Ok(kinds)
 }
 
-/// The maps' settings from the keyword arguments both functions share.
-#[allow(clippy::too_many_arguments)]
-fn held_out_config(
-    res: f64,
-    model: &str,
-    holdout: usize,
-    pixel_step: u32,
-    cast_range: f64,
-    stop_at_ambiguous: bool,
-    op: &str,
-    cuts: u32,
-    prior: Option<PathBuf>,
-    prior_confidence: f32,
-) -> PyResult<HeldOutConfig> {
+/// Keyword arguments read one at a time, each with its default; any left over is refused, as
+/// Python refuses an unexpected keyword.
+struct Options<'py> {
+    given: Option<Bound<'py, PyDict>>,
+    read: Vec<&'static str>,
+}
+
+impl<'py> Options<'py> {
+    fn new(given: Option<&Bound<'py, PyDict>>) -> Self {
+        Self {
+            given: given.cloned(),
+            read: Vec::new(),
+        }
+    }
+
+    /// The option `key`, or `default` when it is not given (or `None`).
+    fn get<T: for<'a> FromPyObject<'a, 'py, Error = PyErr>>(
+        &mut self,
+        key: &'static str,
+        default: T,
+    ) -> PyResult<T> {
+        self.read.push(key);
+        match self
+            .given
+            .as_ref()
+            .map(|d| d.get_item(key))
+            .transpose()?
+            .flatten()
+        {
+            Some(value) if !value.is_none() => value
+                .extract()
+                .map_err(|e| PyTypeError::new_err(format!("{key}: {e}"))),
+            _ => Ok(default),
+        }
+    }
+
+    /// Refuses the options nobody read.
+    fn finish(self, function: &str) -> PyResult<()> {
+        let Some(given) = self.given else {
+            return Ok(());
+        };
+        for key in given.keys() {
+            let key: String = key.extract()?;
+            if !self.read.contains(&key.as_str()) {
+                return Err(PyTypeError::new_err(format!(
+                    "{function}() got an unexpected keyword argument '{key}'"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The maps' settings from the options both functions share (the flags of `rgbd`, with the
+/// command's defaults).
+fn held_out_config(res: f64, options: &mut Options) -> PyResult<HeldOutConfig> {
+    let model: String = options.get("model", "all".to_string())?;
+    let op: String = options.get("op", "product".to_string())?;
     let operator: Family = op
         .parse()
         .map_err(|e| invalid(format!("operator {op:?}: {e}")))?;
-    let models = kinds_of(model)?;
+    let models = kinds_of(&model)?;
     if !models.contains(&MapKind::Fuzzy) && operator != Family::Product {
         return Err(invalid("op applies to the fuzzy model only"));
     }
+    let defaults = HeldOutConfig::new(res);
+    let prior: Option<PathBuf> = options.get("prior", None)?;
+    let prior_confidence = options.get("prior_confidence", 0.5f32)?;
     let config = HeldOutConfig {
         resolution: res,
         models,
-        holdout,
-        pixel_step,
-        cast_range,
-        stop_at_ambiguous,
+        holdout: options.get("holdout", defaults.holdout)?,
+        pixel_step: options.get("pixel_step", defaults.pixel_step)?,
+        cast_range: options.get("cast_range", defaults.cast_range)?,
+        stop_at_ambiguous: options.get("stop_at_ambiguous", defaults.stop_at_ambiguous)?,
         operator,
-        cuts,
+        cuts: options.get("cuts", defaults.cuts)?,
         prior: prior.map(|path| PriorMap {
             path,
             confidence: prior_confidence,
@@ -78,44 +127,23 @@ fn save_all(maps: &[AnyMap], dir: &Path) -> fuzzyvox_core::Result<()> {
 /// Runs ``fuzzyvox rgbd``: builds the maps from the sensor depth of the RGB-D folder ``dir``
 /// (``frame-N.depth.png``, ``frame-N.pose.txt``, ``camera-intrinsics.txt``) at ``res`` metres
 /// from every frame but every ``holdout``-th, ray-casts them into the held-out frames and
-/// returns the report as a dict with the keys of ``fuzzyvox rgbd --json``. The keyword
-/// arguments are the command's flags with their defaults; ``model`` is ``"all"``, a name, a
-/// or comma-separated names; ``save`` writes every map there as
-/// ``MODEL.fvx``. The GIL is released while it runs.
+/// returns the report as a dict with the keys of ``fuzzyvox rgbd --json``. The keyword options
+/// are the command's flags with their defaults: ``model`` (``"all"``, a name or comma-separated
+/// names), ``holdout`` (5), ``pixel_step`` (1), ``cast_range`` (8.0), ``stop_at_ambiguous``
+/// (False), ``op`` (``"product"``), ``cuts`` (10), ``prior`` (None), ``prior_confidence``
+/// (0.5); ``save`` writes every map there as ``MODEL.fvx``. The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (
-    dir, res, model="all", holdout=5, pixel_step=1,
-    cast_range=8.0, stop_at_ambiguous=false, op="product", cuts=10, prior=None,
-    prior_confidence=0.5, save=None
-))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (dir, res, **options))]
 pub fn rgbd<'py>(
     py: Python<'py>,
     dir: PathBuf,
     res: f64,
-    model: &str,
-    holdout: usize,
-    pixel_step: u32,
-    cast_range: f64,
-    stop_at_ambiguous: bool,
-    op: &str,
-    cuts: u32,
-    prior: Option<PathBuf>,
-    prior_confidence: f32,
-    save: Option<PathBuf>,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let config = held_out_config(
-        res,
-        model,
-        holdout,
-        pixel_step,
-        cast_range,
-        stop_at_ambiguous,
-        op,
-        cuts,
-        prior,
-        prior_confidence,
-    )?;
+    let mut options = Options::new(options);
+    let config = held_out_config(res, &mut options)?;
+    let save: Option<PathBuf> = options.get("save", None)?;
+    options.finish("rgbd")?;
     let run = py
         .detach(|| {
             let run = run_rgbd(&dir, &config, &mut |_, _, _| {})?;
@@ -132,59 +160,33 @@ pub fn rgbd<'py>(
 /// ``holdout``-th) through pair selection and the one-camera depth stage, builds the maps at
 /// ``res`` metres from its depth images and checks them against the sensor depth of the
 /// held-out frames; returns the report as a dict with the keys of ``fuzzyvox mono --json``.
-/// The keyword arguments are the command's flags with their defaults (``views`` matched at
-/// once, poses from a TUM ``trajectory``, ``extrinsics`` file of ``depth_from_color``, the
-/// depth range ``near`` to ``far``, ``min_baseline`` of a pair); ``out`` writes every map there
-/// as ``MODEL.fvx``. The GIL is released while it runs.
+/// The keyword options are those of :func:`rgbd` (but ``save``) and the command's own flags
+/// with their defaults: ``views`` matched at once (2), poses from a TUM ``trajectory``, an
+/// ``extrinsics`` file of ``depth_from_color``, the depth range ``near`` (0.3) to ``far`` (8.0),
+/// ``min_baseline`` of a pair (0.05); ``out`` writes every map there as ``MODEL.fvx``. The GIL
+/// is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (
-    dir, res, model="all", holdout=5, pixel_step=1,
-    cast_range=8.0, stop_at_ambiguous=false, op="product", cuts=10, prior=None,
-    prior_confidence=0.5, views=2, trajectory=None, extrinsics=None, near=0.3, far=8.0,
-    min_baseline=0.05, out=None
-))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (dir, res, **options))]
 pub fn mono<'py>(
     py: Python<'py>,
     dir: PathBuf,
     res: f64,
-    model: &str,
-    holdout: usize,
-    pixel_step: u32,
-    cast_range: f64,
-    stop_at_ambiguous: bool,
-    op: &str,
-    cuts: u32,
-    prior: Option<PathBuf>,
-    prior_confidence: f32,
-    views: u32,
-    trajectory: Option<PathBuf>,
-    extrinsics: Option<PathBuf>,
-    near: f64,
-    far: f64,
-    min_baseline: f64,
-    out: Option<PathBuf>,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let mut options = Options::new(options);
+    let held_out = held_out_config(res, &mut options)?;
+    let defaults = MonoConfig::new(res);
     let config = MonoConfig {
-        held_out: held_out_config(
-            res,
-            model,
-            holdout,
-            pixel_step,
-            cast_range,
-            stop_at_ambiguous,
-            op,
-            cuts,
-            prior,
-            prior_confidence,
-        )?,
-        views,
-        trajectory,
-        extrinsics,
-        near,
-        far,
-        min_baseline,
+        held_out,
+        views: options.get("views", defaults.views)?,
+        trajectory: options.get("trajectory", None)?,
+        extrinsics: options.get("extrinsics", None)?,
+        near: options.get("near", defaults.near)?,
+        far: options.get("far", defaults.far)?,
+        min_baseline: options.get("min_baseline", defaults.min_baseline)?,
     };
+    let out: Option<PathBuf> = options.get("out", None)?;
+    options.finish("mono")?;
     config.validate().or_raise()?;
     let run = py
         .detach(|| {

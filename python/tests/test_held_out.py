@@ -81,3 +81,15 @@ def test_held_out_runs_refuse_bad_settings(tmp_path):
     report = fuzzyvox.rgbd(folder, 0.1, model="fuzzy", pixel_step=16, save=tmp_path / "maps")
     assert [m["model"] for m in report["maps"]] == ["fuzzy"]
     assert fuzzyvox.load(tmp_path / "maps" / "fuzzy.fvx").kind == "fuzzy"
+
+
+def test_held_out_options_are_checked_before_any_work(tmp_path):
+    missing = tmp_path / "no-such-folder"
+    with pytest.raises(TypeError, match="unexpected keyword argument 'pixelstep'"):
+        fuzzyvox.rgbd(missing, 0.1, pixelstep=8)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'save'"):
+        fuzzyvox.mono(missing, 0.1, save=tmp_path)
+    with pytest.raises(TypeError, match="holdout"):
+        fuzzyvox.rgbd(missing, 0.1, holdout="five")
+    with pytest.raises(fuzzyvox.MapFileError):
+        fuzzyvox.rgbd(missing, 0.1, holdout=5)

@@ -66,4 +66,6 @@ def test_every_function_has_a_docstring_and_its_stub_signature():
             continue
         assert obj.__doc__, name
         params = list(inspect.signature(obj).parameters)
-        assert params == [a.arg for a in stubs[name].args.args], name
+        stub = stubs[name].args
+        keywords = [stub.kwarg.arg] if stub.kwarg else []
+        assert params == [a.arg for a in stub.args] + keywords, name

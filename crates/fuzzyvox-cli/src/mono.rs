@@ -111,14 +111,14 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
         "{}: {} frames; {} build the maps ({} depth images: {} rectified, {} swept, {} multi-view; \
          {} without), {} held out ({} with sensor depth)",
         args.dir.display(),
-        report.frames,
-        report.build_frames,
+        report.split.frames,
+        report.split.build_frames,
         report.depth_images,
         report.rectified,
         report.swept,
         report.multi_view,
         report.skipped.values().sum::<usize>(),
-        report.held_out_frames,
+        report.split.held_out_frames,
         report.held_out_checked,
     );
     for (reason, n) in &report.skipped {

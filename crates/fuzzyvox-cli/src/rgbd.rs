@@ -55,10 +55,10 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
     let report = &run.report;
     info!(
         "{} frames in {}: {} built the maps, {} were held out",
-        report.frames,
+        report.split.frames,
         args.dir.display(),
-        report.build_frames,
-        report.held_out_frames
+        report.split.build_frames,
+        report.split.held_out_frames
     );
     if let Some(dir) = &args.save {
         save_all(&run.maps, dir)?;
@@ -69,11 +69,11 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
     println!(
         "{}: {} frames, maps from {} at {} m, checked on {} held-out frames (every {}th)",
         args.dir.display(),
-        report.frames,
-        report.build_frames,
-        report.resolution,
-        report.held_out_frames,
-        report.holdout,
+        report.split.frames,
+        report.split.build_frames,
+        report.split.resolution,
+        report.split.held_out_frames,
+        report.split.holdout,
     );
     print_table(&report.maps);
     Ok(())

@@ -38,8 +38,9 @@ pub use flights::{
     plan_queries, summarize,
 };
 pub use held_out::{
-    DepthStageReport, HeldOutConfig, HeldOutStage, MapCheckReport, MonoConfig, MonoReport, MonoRun,
-    MonoSeconds, PriorMap, RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on,
+    DepthStageReport, FolderSplit, HeldOutConfig, HeldOutRun, HeldOutStage, MapCheckReport,
+    MonoConfig, MonoReport, MonoRun, MonoSeconds, PriorMap, RgbdReport, RgbdRun, run_mono,
+    run_mono_on, run_rgbd, run_rgbd_on,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};

@@ -11,6 +11,7 @@ mod maps;
 mod mono;
 mod mono_config;
 mod rgbd;
+mod run;
 mod stage;
 
 pub use config::{HeldOutConfig, PriorMap};
@@ -18,4 +19,5 @@ pub use maps::MapCheckReport;
 pub use mono::{DepthStageReport, MonoReport, MonoRun, MonoSeconds, run_mono, run_mono_on};
 pub use mono_config::MonoConfig;
 pub use rgbd::{RgbdReport, RgbdRun, run_rgbd, run_rgbd_on};
+pub use run::{FolderSplit, HeldOutRun};
 pub use stage::HeldOutStage;

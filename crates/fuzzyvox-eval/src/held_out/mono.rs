@@ -9,12 +9,12 @@ use serde::Serialize;
 
 use super::maps::{MapCheckReport, MapUnderTest, check_all, integrate_all};
 use super::mono_config::MonoConfig;
+use super::run::{FolderSplit, HeldOutRun};
 use super::stage::HeldOutStage;
 use crate::depth_stage::{DepthStageErrors, DepthStageSummary};
 use crate::rgbd::HoldoutSplit;
 use fuzzyvox_core::error::Result;
 use fuzzyvox_core::integrate::IntegrationOptions;
-use fuzzyvox_core::map::AnyMap;
 use fuzzyvox_io::posed::PosedFolder;
 use fuzzyvox_io::rgbd::read_pose_txt;
 
@@ -46,20 +46,11 @@ pub struct MonoSeconds {
 /// The report of [`run_mono`]: its JSON is what `fuzzyvox mono --json` prints.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MonoReport {
-    /// The image folder.
-    pub dir: PathBuf,
-    /// Frames in the folder.
-    pub frames: usize,
-    /// Frames that went through the depth stage into the maps.
-    pub build_frames: usize,
-    /// Frames held out.
-    pub held_out_frames: usize,
+    /// The image folder and which of its frames went through the depth stage into the maps.
+    #[serde(flatten)]
+    pub split: FolderSplit,
     /// Held-out frames with sensor depth, the ones the maps were checked on.
     pub held_out_checked: usize,
-    /// Every K-th frame was held out.
-    pub holdout: usize,
-    /// Voxel size (m).
-    pub resolution: f64,
     /// Views matched at once.
     pub views: u32,
     /// `[near, far]` searched (m).
@@ -88,14 +79,8 @@ pub struct MonoReport {
     pub maps: Vec<MapCheckReport>,
 }
 
-/// What [`run_mono`] returns: the report and the built maps (in the report's order).
-#[derive(Debug)]
-pub struct MonoRun {
-    /// The report.
-    pub report: MonoReport,
-    /// The maps, built from the depth stage's images of every frame but the held-out ones.
-    pub maps: Vec<AnyMap>,
-}
+/// What [`run_mono`] returns.
+pub type MonoRun = HeldOutRun<MonoReport>;
 
 /// Opens the folder of posed colour frames `dir` (`frame-N.color.png` or `.jpg`, poses from
 /// `frame-N.pose.txt` or `config.trajectory`, `camera-intrinsics.txt` and optionally
@@ -188,13 +173,14 @@ pub fn run_mono_on(
     let counts = stream.counts();
     let mapping = (seconds.read + seconds.depth + seconds.integrate).max(1e-9);
     let report = MonoReport {
-        dir: folder.dir.clone(),
-        frames: folder.frames.len(),
-        build_frames: split.build.len(),
-        held_out_frames: split.held_out.len(),
+        split: FolderSplit::new(
+            &folder.dir,
+            folder.frames.len(),
+            &split,
+            held_out.holdout,
+            held_out.resolution,
+        ),
         held_out_checked: checked,
-        holdout: held_out.holdout,
-        resolution: held_out.resolution,
         views: config.views,
         depth_range: [config.near, config.far],
         color_intrinsics: folder.color_intrinsics.clone(),

@@ -1,52 +1,21 @@
 //! `run_rgbd`: maps built from the sensor depth of an RGB-D folder, checked against its
 //! held-out frames (what `fuzzyvox rgbd` runs).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Serialize;
 
 use super::config::HeldOutConfig;
 use super::maps::{MapCheckReport, MapUnderTest, check_all, integrate_all};
+use super::run::{FolderSplit, HeldOutRun};
 use super::stage::HeldOutStage;
 use crate::rgbd::HoldoutSplit;
 use fuzzyvox_core::error::Result;
 use fuzzyvox_core::integrate::IntegrationOptions;
-use fuzzyvox_core::map::AnyMap;
 use fuzzyvox_io::rgbd::RgbdFolder;
 
-/// The report of [`run_rgbd`]: its JSON is what `fuzzyvox rgbd --json` prints.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RgbdReport {
-    /// The RGB-D folder.
-    pub dir: PathBuf,
-    /// Frames in the folder.
-    pub frames: usize,
-    /// Frames that built the maps.
-    pub build_frames: usize,
-    /// Frames held out.
-    pub held_out_frames: usize,
-    /// Every K-th frame was held out.
-    pub holdout: usize,
-    /// Voxel size (m).
-    pub resolution: f64,
-    /// Every N-th pixel of the held-out frames was checked.
-    pub pixel_step: u32,
-    /// Rays were cast this far (m).
-    pub cast_range: f64,
-    /// Whether ambiguous voxels stopped rays.
-    pub stop_at_ambiguous: bool,
-    /// One report per map, in [`fuzzyvox_core::map::MapKind::ALL`] order.
-    pub maps: Vec<MapCheckReport>,
-}
-
-/// What [`run_rgbd`] returns: the report and the built maps (in the report's order).
-#[derive(Debug)]
-pub struct RgbdRun {
-    /// The report.
-    pub report: RgbdReport,
-    /// The maps, built from every frame but the held-out ones.
-    pub maps: Vec<AnyMap>,
-}
+/// What [`run_rgbd`] returns.
+pub type RgbdRun = HeldOutRun<RgbdReport>;
 
 /// Opens the RGB-D folder `dir` (`frame-N.depth.png`, `frame-N.pose.txt`,
 /// `camera-intrinsics.txt`: the 7-Scenes / 3DMatch layout) and runs [`run_rgbd_on`] on it.
@@ -97,12 +66,13 @@ pub fn run_rgbd_on(
         }
     }
     let report = RgbdReport {
-        dir: folder.dir.clone(),
-        frames: folder.frames.len(),
-        build_frames: split.build.len(),
-        held_out_frames: split.held_out.len(),
-        holdout: config.holdout,
-        resolution: config.resolution,
+        split: FolderSplit::new(
+            &folder.dir,
+            folder.frames.len(),
+            &split,
+            config.holdout,
+            config.resolution,
+        ),
         pixel_step: config.pixel_step,
         cast_range: config.cast_range,
         stop_at_ambiguous: config.stop_at_ambiguous,
@@ -115,4 +85,20 @@ pub fn run_rgbd_on(
         report,
         maps: maps.into_iter().map(|m| m.map).collect(),
     })
+}
+
+/// The report of [`run_rgbd`]: its JSON is what `fuzzyvox rgbd --json` prints.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RgbdReport {
+    /// The RGB-D folder and which of its frames built the maps.
+    #[serde(flatten)]
+    pub split: FolderSplit,
+    /// Every N-th pixel of the held-out frames was checked.
+    pub pixel_step: u32,
+    /// Rays were cast this far (m).
+    pub cast_range: f64,
+    /// Whether ambiguous voxels stopped rays.
+    pub stop_at_ambiguous: bool,
+    /// One report per map, in [`fuzzyvox_core::map::MapKind::ALL`] order.
+    pub maps: Vec<MapCheckReport>,
 }
