@@ -88,9 +88,6 @@ fn held_out_config(res: f64, options: &mut Options) -> PyResult<HeldOutConfig> {
         .parse()
         .map_err(|e| invalid(format!("operator {op:?}: {e}")))?;
     let models = kinds_of(&model)?;
-    if !models.contains(&MapKind::Fuzzy) && operator != Family::Product {
-        return Err(invalid("op applies to the fuzzy model only"));
-    }
     let defaults = HeldOutConfig::new(res);
     let prior: Option<PathBuf> = options.get("prior", None)?;
     let prior_confidence = options.get("prior_confidence", 0.5f32)?;

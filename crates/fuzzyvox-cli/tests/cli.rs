@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{data_dir, fuzzyvox, json};
+use common::{data_dir, fuzzyvox, insert_wall, json};
 
 #[test]
 fn insert_logodds_reports_octomap_counts() {
@@ -180,7 +180,6 @@ fn insert_reads_octomap_scan_graphs_and_alpha_refuses_them() {
 /// observed extent is [0, -3, -1.5] to [3.1, 3.1, 2.6] m.
 fn wall_map(dir: &std::path::Path) -> std::path::PathBuf {
     std::fs::create_dir_all(dir).unwrap();
-    let cloud = dir.join("wall.xyz");
     let mut text = String::new();
     for i in 0..=120 {
         for j in 0..=80 {
@@ -188,21 +187,7 @@ fn wall_map(dir: &std::path::Path) -> std::path::PathBuf {
             text.push_str(&format!("3.0 {y} {z}\n"));
         }
     }
-    std::fs::write(&cloud, text).unwrap();
-    let map = dir.join("wall.fvx");
-    json(&fuzzyvox(&[
-        "insert",
-        "--cloud",
-        cloud.to_str().unwrap(),
-        "--res",
-        "0.1",
-        "--origin",
-        "0,0,0.5",
-        "--out",
-        map.to_str().unwrap(),
-        "--json",
-    ]));
-    map
+    insert_wall(dir, &text)
 }
 
 #[test]
@@ -566,7 +551,7 @@ fn printed_plan_examples_work() {
         map.to_str().unwrap(),
         "--json",
     ]));
-    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+    let root = common::repo_root();
     let mut examples = Vec::new();
     for doc in ["README.md", "docs/planning.md", "docs/cli.md"] {
         let found = plan_examples(&std::fs::read_to_string(root.join(doc)).unwrap());

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{Rng, fuzzyvox, json};
+use common::{Rng, fuzzyvox, insert_wall, json};
 
 /// Runs a command that must fail with `code` and a message containing `expected`.
 fn fails(args: &[&str], code: i32, expected: &str) {
@@ -27,7 +27,6 @@ fn scratch(name: &str) -> PathBuf {
 
 /// A fuzzy map of a 2 × 1 m wall at x = 3 m, seen from (0, 0, 0.5), at 0.1 m.
 fn wall_map(dir: &Path) -> PathBuf {
-    let cloud = dir.join("wall.xyz");
     let mut text = String::new();
     for i in 0..=40 {
         for j in 0..=20 {
@@ -35,21 +34,7 @@ fn wall_map(dir: &Path) -> PathBuf {
             text.push_str(&format!("3.0 {y} {z} 0.9\n"));
         }
     }
-    std::fs::write(&cloud, text).unwrap();
-    let map = dir.join("wall.fvx");
-    json(&fuzzyvox(&[
-        "insert",
-        "--cloud",
-        cloud.to_str().unwrap(),
-        "--res",
-        "0.1",
-        "--origin",
-        "0,0,0.5",
-        "--out",
-        map.to_str().unwrap(),
-        "--json",
-    ]));
-    map
+    insert_wall(dir, &text)
 }
 
 #[test]

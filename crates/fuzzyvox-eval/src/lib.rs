@@ -1,17 +1,23 @@
-//! Evaluation of maps against ground truth: the quantitative metrics the paper could not give.
+//! The experiment layer: every experiment fuzzyvox runs, as library functions returning
+//! serializable reports (the command prints them as they are, Python returns them as dicts).
 //!
-//! [`GroundTruth`] holds, for a resolution, the voxels that meet the true scene geometry and
-//! the region the cameras could observe (from the "gold standard": true depth inserted with the
-//! standard method). [`evaluate`] compares any map with it: occupied precision, recall and F1;
-//! holes (truly occupied voxels the map calls free); spurious occupied voxels in the truly
-//! unknown region (behind walls, in the sky); and the Chamfer distance from occupied voxel
-//! centres to the true surface.
-//!
-//! [`run_experiment`] feeds identical depth-stage output to every map, measures each after
-//! every phase and, optionally, plans flights in each map and checks them against the true
-//! scene ([`fly`]). [`HoldoutSplit`] and [`DepthErrors`] evaluate maps of real RGB-D data by
-//! ray-casting them into held-out frames; [`run_rgbd`] and [`run_mono`] run the held-out
-//! experiments on real RGB-D folders and posed colour images.
+//! - Ground truth and metrics: [`GroundTruth`] holds, for a resolution, the voxels that meet
+//!   the true scene geometry and the region the cameras could observe (from the "gold
+//!   standard": true depth inserted with the standard method). [`evaluate`] compares any map
+//!   with it: occupied precision, recall and F1; holes (truly occupied voxels the map calls
+//!   free); spurious occupied voxels in the truly unknown region (behind walls, in the sky);
+//!   and the Chamfer distance from occupied voxel centres to the true surface.
+//! - Flights checked against the truth: one drawer of start/goal pairs ([`draw_queries`] with
+//!   a [`QueryConfig`]), planning in a map ([`plan_queries`]) and one path check against the
+//!   true world ([`Obstacles`], [`path_collides`]).
+//! - The open-loop experiment: [`run_experiment`] feeds identical depth-stage output to every
+//!   map, measures each after every phase and, optionally, plans flights in each map.
+//! - Closed-loop flights ([`closed_loop`]): the vehicle of `fuzzyvox_fly` flown to goals drawn
+//!   from the truth, with every map.
+//! - Held-out runs on real frames: [`run_rgbd`] and [`run_mono`] build maps from an RGB-D folder
+//!   or posed colour images and ray-cast them into frames they have not seen ([`HoldoutSplit`],
+//!   [`DepthErrors`]).
+//! - Reports: Markdown, HTML, figures and charts of each.
 
 mod charts;
 pub mod closed_loop;

@@ -8,6 +8,7 @@ pub mod octomap;
 #[path = "../../../../tests/common/mod.rs"]
 mod library;
 
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 // Each test binary uses a few of these.
@@ -31,4 +32,30 @@ pub fn json(output: &Output) -> serde_json::Value {
         String::from_utf8_lossy(&output.stderr)
     );
     serde_json::from_slice(&output.stdout).expect("one JSON object on stdout")
+}
+
+/// The repository's root (the command's crate is `crates/fuzzyvox-cli` in it).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// Writes `cloud` (text, one point a line) as `dir/wall.xyz` and inserts it, as seen from
+/// (0, 0, 0.5), into a fuzzy map at 0.1 m saved as `dir/wall.fvx`; returns the map's path.
+pub fn insert_wall(dir: &Path, cloud: &str) -> PathBuf {
+    let cloud_path = dir.join("wall.xyz");
+    std::fs::write(&cloud_path, cloud).unwrap();
+    let map = dir.join("wall.fvx");
+    json(&fuzzyvox(&[
+        "insert",
+        "--cloud",
+        cloud_path.to_str().unwrap(),
+        "--res",
+        "0.1",
+        "--origin",
+        "0,0,0.5",
+        "--out",
+        map.to_str().unwrap(),
+        "--json",
+    ]));
+    map
 }

@@ -29,7 +29,7 @@ pub fn octomap_tool(test: &str) -> Option<PathBuf> {
     // One binary per test: tests run in parallel, and running a binary while another test
     // rewrites it fails with "text file busy".
     let tool = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("octomap_check-{test}"));
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/octomap_check.cpp");
+    let source = super::repo_root().join("scripts/octomap_check.cpp");
     let output = Command::new("g++")
         .args(["-O2", "-std=c++17"])
         .arg(&source)

@@ -112,6 +112,11 @@ impl HeldOutConfig {
         for kind in self.kinds() {
             kind.new_map_with(self.resolution, &self.map_options())?;
         }
+        if self.operator != Family::Product && !self.kinds().contains(&MapKind::Fuzzy) {
+            return Err(Error::Incompatible(
+                "the operator applies to the fuzzy model only".to_string(),
+            ));
+        }
         if let Some(prior) = &self.prior {
             if self.kinds() != [MapKind::Fuzzy] {
                 return Err(Error::Incompatible(
