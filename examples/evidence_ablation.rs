@@ -118,7 +118,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         report.scenario,
         report.pairs,
         output.flight_queries.len(),
-        report.truth_flights.map_or(0.0, |f| f.plan_success)
+        report
+            .truth_flights
+            .as_ref()
+            .map_or(0.0, |f| f.plan_success)
     );
     println!(
         "| map | free voxels | flight success | collisions | start/goal unsafe, disconnected | holes | spurious | precision | recall | F1 |"
@@ -128,6 +131,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let m = &map.metrics;
         let (success, collisions, failures) =
             map.flights
+                .as_ref()
                 .map_or(("-".to_string(), "-".to_string(), "-".to_string()), |f| {
                     let p = f.plan_failures;
                     (

@@ -256,6 +256,9 @@ class MonoOptions(HeldOutOptions, total=False):
     near: float  # 0.3
     far: float  # 8.0
     min_baseline: float  # 0.05
+    plan: Optional[int]  # None: no flights
+    seed: int  # 1
+    radius: float  # 0.2
     out: Optional[_Path]
 
 def rgbd(dir: _Path, res: float, **options: Unpack[RgbdOptions]) -> dict[str, Any]: ...

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use fuzzyvox_core::{AnyMap, Family, MapKind};
-use fuzzyvox_eval::{HeldOutConfig, MonoConfig, PriorMap, run_mono, run_rgbd};
+use fuzzyvox_eval::{HeldOutConfig, MonoConfig, PriorMap, RealFlightConfig, run_mono, run_rgbd};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -160,8 +160,9 @@ pub fn rgbd<'py>(
 /// The keyword options are those of :func:`rgbd` (but ``save``) and the command's own flags
 /// with their defaults: ``views`` matched at once (2), poses from a TUM ``trajectory``, an
 /// ``extrinsics`` file of ``depth_from_color``, the depth range ``near`` (0.3) to ``far`` (8.0),
-/// ``min_baseline`` of a pair (0.05); ``out`` writes every map there as ``MODEL.fvx``. The GIL
-/// is released while it runs.
+/// ``min_baseline`` of a pair (0.05); ``plan`` flights through every map (``None``: none; as
+/// ``fuzzyvox mono --plan``, with ``seed`` (1) and the vehicle's ``radius`` (0.2)); ``out``
+/// writes every map there as ``MODEL.fvx``. The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (dir, res, **options))]
 pub fn mono<'py>(
@@ -181,6 +182,22 @@ pub fn mono<'py>(
         near: options.get("near", defaults.near)?,
         far: options.get("far", defaults.far)?,
         min_baseline: options.get("min_baseline", defaults.min_baseline)?,
+        flights: None,
+    };
+    let plan: Option<usize> = options.get("plan", None)?;
+    let config = MonoConfig {
+        flights: match plan {
+            Some(queries) => {
+                let flights = RealFlightConfig::new(queries);
+                Some(RealFlightConfig {
+                    seed: options.get("seed", flights.seed)?,
+                    vehicle_radius: options.get("radius", flights.vehicle_radius)?,
+                    ..flights
+                })
+            }
+            None => None,
+        },
+        ..config
     };
     let out: Option<PathBuf> = options.get("out", None)?;
     options.finish("mono")?;

@@ -18,9 +18,9 @@ BINARY = Path(__file__).resolve().parents[2] / "target" / "release" / "fuzzyvox"
 SETTINGS = {"res": 0.1, "pixel_step": 8}
 
 
-def few_frames(tmp_path: Path, count: int) -> Path:
-    """The first `count` frames of the 7-Scenes sequence, linked into a folder of their own."""
-    source = data_file("rgbd-7scenes-redkitchen/camera-intrinsics.txt").parent
+def few_frames(tmp_path: Path, count: int, sequence: str = "rgbd-7scenes-redkitchen") -> Path:
+    """The first `count` frames of a shared sequence, linked into a folder of their own."""
+    source = data_file(f"{sequence}/camera-intrinsics.txt").parent
     folder = tmp_path / "frames"
     folder.mkdir()
     numbers = sorted({p.name.split(".")[0] for p in source.glob("frame-*")})[:count]
@@ -30,13 +30,14 @@ def few_frames(tmp_path: Path, count: int) -> Path:
     return folder
 
 
-def command_json(command: str, folder: Path) -> dict:
-    """`fuzzyvox COMMAND --dir FOLDER ... --json` with the same settings."""
+def command_json(command: str, folder: Path, *extra: str) -> dict:
+    """`fuzzyvox COMMAND --dir FOLDER ... --json` with the same settings (and `extra`)."""
     if not BINARY.is_file():
         pytest.fail(f"{BINARY} is missing: build it with `cargo build --release --bin fuzzyvox`")
     args = [str(BINARY), command, "--dir", str(folder), "--json"]
     for key, value in SETTINGS.items():
         args += ["--" + key.replace("_", "-"), str(value)]
+    args += extra
     done = subprocess.run(args, capture_output=True, text=True, check=True)
     return json.loads(done.stdout)
 
@@ -66,6 +67,19 @@ def test_mono_report_has_the_commands_keys(tmp_path):
     assert key_tree(report) == key_tree(command_json("mono", folder))
     assert report["depth_range"] == [0.3, 8.0]
     assert set(report["seconds"]) == {"read", "depth", "integrate", "check"}
+    assert "plan_queries" not in report["maps"][0]
+
+
+def test_mono_flights_have_the_commands_keys_and_figures(tmp_path):
+    # Half the HoloLens walk: room enough near the camera path for start/goal pairs.
+    folder = few_frames(tmp_path, 40, "rgbd-hololens-000")
+    report = fuzzyvox.mono(folder, **SETTINGS, plan=3, seed=2)
+    command = command_json("mono", folder, "--plan", "3", "--seed", "2")
+    assert key_tree(report) == key_tree(command)
+    for ours, theirs in zip(report["maps"], command["maps"]):
+        assert 0 < ours["plan_queries"] <= 3
+        for key in ["plan_queries", "plan_success", "plan_collisions", "reference_plan_success"]:
+            assert ours[key] == theirs[key], key
 
 
 def test_held_out_runs_refuse_bad_settings(tmp_path):

@@ -2,7 +2,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::eval::{MonoConfig, run_mono_on};
+use fuzzyvox::eval::{MapCheckReport, MonoConfig, RealFlightConfig, run_mono_on};
 use fuzzyvox::io::posed::PosedFolder;
 use fuzzyvox::io::rgbd::read_pose_txt;
 use tracing::info;
@@ -32,7 +32,8 @@ use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table, save_all
 #[command(after_help = "Examples:\n  \
     fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04\n  \
     fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04 --views 3 --json\n  \
-    fuzzyvox mono --dir DIR --res 0.05 --trajectory poses.tum --model fuzzy --out maps/")]
+    fuzzyvox mono --dir DIR --res 0.05 --trajectory poses.tum --model fuzzy --out maps/\n  \
+    fuzzyvox mono --dir ../shared/data/rgbd-hololens-000 --res 0.05 --plan 50 --json")]
 pub struct MonoArgs {
     /// The folder of posed colour frames.
     #[arg(long)]
@@ -59,6 +60,25 @@ pub struct MonoArgs {
     /// Smallest baseline of a pair (metres).
     #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
     min_baseline: f64,
+    /// Plan N flights through every map: start/goal pairs drawn in the free space of a
+    /// reference map of the folder's sensor depth (all frames, log-odds), near the camera path,
+    /// planned with unknown space forbidden and checked against the reference's occupied voxels
+    /// (JSON per map: plan_queries, plan_success, plan_collisions, plan_failures,
+    /// plan_collision_details, reference_plan_success).
+    #[arg(long, value_name = "N")]
+    plan: Option<usize>,
+    /// Seed of the flights' draw.
+    #[arg(long, default_value_t = 1, requires = "plan")]
+    seed: u64,
+    /// The vehicle's radius for the flights (metres).
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 0.2,
+        requires = "plan",
+        allow_negative_numbers = true
+    )]
+    radius: f64,
     /// Save every map here as MODEL.fvx.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -76,6 +96,11 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
         near: args.near,
         far: args.far,
         min_baseline: args.min_baseline,
+        flights: args.plan.map(|queries| RealFlightConfig {
+            seed: args.seed,
+            vehicle_radius: args.radius,
+            ..RealFlightConfig::new(queries)
+        }),
     };
     config.validate().map_err(flag_error)?;
     let extrinsics = match &args.extrinsics {
@@ -140,5 +165,30 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
         100.0 * stage.share_of_mapping_time
     );
     print_table(&report.maps);
+    print_flights(&report.maps);
     Ok(())
+}
+
+/// The flights of every map, when there were any.
+fn print_flights(maps: &[MapCheckReport]) {
+    let flown: Vec<_> = maps
+        .iter()
+        .filter_map(|m| Some((m.model, m.flights.as_ref()?)))
+        .collect();
+    let Some((_, first)) = flown.first() else {
+        return;
+    };
+    println!(
+        "flights: {} start/goal pairs near the camera path; the sensor-depth reference solves {:.2}",
+        first.summary.plan_queries, first.reference_plan_success
+    );
+    println!("{:<8} {:>9} {:>10}", "model", "success", "collisions");
+    for (model, f) in flown {
+        println!(
+            "{:<8} {:>9.2} {:>10}",
+            model.name(),
+            f.summary.plan_success,
+            f.summary.plan_collisions
+        );
+    }
 }

@@ -51,6 +51,7 @@ fn eval_wall_reports_every_map_after_each_phase_with_flights_and_figures() {
             "plan_success",
             "plan_collisions",
             "path_length_ratio",
+            "plan_collision_details",
         ] {
             assert!(map.get(key).is_some(), "{name} lacks {key}: {map}");
         }

@@ -69,6 +69,10 @@ fn mono_maps_simulated_frames_deterministically_without_sensor_depth() {
     assert_eq!(first["frames"], 24);
     assert_eq!(first["build_frames"], 18);
     assert_eq!(first["held_out_checked"], 6);
+    assert!(
+        first["maps"][0].get("plan_queries").is_none(),
+        "no flights without --plan"
+    );
     let images = first["depth_images"].as_u64().unwrap();
     assert!(images >= 10, "{first}");
     assert!(first["rectified"].as_u64().unwrap() > 0);
@@ -266,6 +270,86 @@ fn mono_refuses_bad_folders_and_options_clearly() {
     let unnormalised = root.join("unnormalised.tum");
     std::fs::write(&unnormalised, "0 0 0 0 0 0 0 2\n").unwrap();
     run(&unnormalised, "quaternion");
+}
+
+#[test]
+fn mono_plans_flights_through_every_map_against_a_map_of_the_sensor_depth() {
+    let frames = simulated("flights");
+    let root = frames.parent().unwrap().to_path_buf();
+    let report = mono(&frames, &root.join("maps"), &["--plan", "8", "--seed", "3"]);
+    let maps = report["maps"].as_array().unwrap();
+    assert_eq!(maps.len(), 3);
+    for map in maps {
+        assert_eq!(map["plan_queries"], 8, "{map}");
+        // The queries lie in the reference's free space, clear of its occupied voxels: the
+        // reference solves them.
+        assert!(
+            map["reference_plan_success"].as_f64().unwrap() >= 0.75,
+            "{map}"
+        );
+        assert_eq!(
+            map["reference_plan_success"],
+            maps[0]["reference_plan_success"]
+        );
+        let success = map["plan_success"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&success), "{map}");
+        let collisions = map["plan_collisions"].as_u64().unwrap();
+        let details = map["plan_collision_details"].as_array().unwrap();
+        assert_eq!(details.len() as u64, collisions);
+        for detail in details {
+            assert!(
+                detail["distance_to_surface"].as_f64().unwrap() < 0.2,
+                "{detail}"
+            );
+            assert!(detail["class"].is_string(), "{detail}");
+        }
+        let failures = &map["plan_failures"];
+        let failed: u64 = [
+            "start_unsafe",
+            "goal_unsafe",
+            "disconnected",
+            "out_of_region",
+            "error",
+        ]
+        .iter()
+        .map(|k| failures[*k].as_u64().unwrap())
+        .sum();
+        assert!(
+            (failed as f64 - 8.0 * (1.0 - success)).abs() < 1e-9,
+            "{failures} against {success}"
+        );
+    }
+    // The same seed draws the same queries: the same figures again.
+    let again = mono(
+        &frames,
+        &root.join("maps-again"),
+        &["--plan", "8", "--seed", "3"],
+    );
+    for (a, b) in maps.iter().zip(again["maps"].as_array().unwrap()) {
+        for key in [
+            "plan_success",
+            "plan_collisions",
+            "reference_plan_success",
+            "plan_failures",
+        ] {
+            assert_eq!(a[key], b[key], "{key}");
+        }
+    }
+    let refused = fuzzyvox(&[
+        "mono",
+        "--dir",
+        frames.to_str().unwrap(),
+        "--res",
+        "0.2",
+        "--plan",
+        "0",
+    ]);
+    assert!(!refused.status.success());
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("flights to plan"),
+        "{}",
+        String::from_utf8_lossy(&refused.stderr)
+    );
 }
 
 #[test]

@@ -39,14 +39,14 @@ pub use experiment::{
 };
 pub use figures::{TopDownView, depth_panels_png, flights_png, top_down_png};
 pub use flights::{
-    BlockedByCounts, BlockingClass, Candidates, Connect, FailureCounts, FlightFailure,
-    FlightOutcome, FlightQuery, FlightSummary, Obstacles, QueryConfig, draw_queries, path_collides,
-    plan_queries, summarize,
+    BlockedByCounts, BlockingClass, Candidates, CollisionDetail, Connect, FailureCounts,
+    FlightFailure, FlightOutcome, FlightQuery, FlightSummary, Obstacles, OccupiedVoxels,
+    QueryConfig, draw_queries, path_collides, path_contact, plan_queries, summarize,
 };
 pub use held_out::{
     DepthStageReport, FolderSplit, HeldOutConfig, HeldOutRun, HeldOutStage, MapCheckReport,
-    MonoConfig, MonoReport, MonoRun, MonoSeconds, PriorMap, RgbdReport, RgbdRun, run_mono,
-    run_mono_on, run_rgbd, run_rgbd_on,
+    MonoConfig, MonoReport, MonoRun, MonoSeconds, PriorMap, RealFlightConfig, RealFlights,
+    RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};

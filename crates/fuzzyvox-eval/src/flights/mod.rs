@@ -4,18 +4,20 @@
 //! gave ([`outcome`]). The open-loop experiment (`eval`), the closed-loop flights (`fly`) and
 //! the runs on real frames all draw, plan and check through these.
 
+mod occupied;
 mod outcome;
 mod plan;
 mod queries;
 mod world;
 
+pub use occupied::OccupiedVoxels;
 pub use outcome::{
-    BlockedByCounts, BlockingClass, FailureCounts, FlightFailure, FlightOutcome, FlightSummary,
-    summarize,
+    BlockedByCounts, BlockingClass, CollisionDetail, FailureCounts, FlightFailure, FlightOutcome,
+    FlightSummary, summarize,
 };
 pub use plan::plan_queries;
 pub use queries::{Candidates, Connect, FlightQuery, QueryConfig, draw_queries};
-pub use world::{Obstacles, path_collides};
+pub use world::{Obstacles, path_collides, path_contact};
 
 #[cfg(test)]
 mod tests {
@@ -154,9 +156,21 @@ mod tests {
         );
         let judged = plan_queries(&map, &blocked, &[safe], &planner);
         assert!(judged[0].collides);
+        // The collision is explained: where the ball first meets the pillar, and what the map
+        // (which never saw the pillar) said there.
+        let detail = judged[0].collision.unwrap();
+        assert_eq!((detail.from, detail.to), (safe.from, safe.to));
+        assert!(
+            detail.distance_to_surface < planner.vehicle_radius,
+            "{detail:?}"
+        );
+        assert!(blocked.distance_to_surface(&detail.point) < planner.vehicle_radius);
+        assert_eq!(detail.class, "free");
+        assert!(outcomes[0].collision.is_none());
         let summary = summarize(&judged, &outcomes);
         assert_eq!(summary.plan_queries, 1);
         assert_eq!(summary.plan_collisions, 1);
+        assert_eq!(summary.plan_collision_details, vec![detail]);
         assert!((summary.plan_success - 1.0).abs() < 1e-12);
         assert!((summary.path_length_ratio.unwrap() - 1.0).abs() < 1e-12);
         // A goal inside the wall has no path.
@@ -187,5 +201,31 @@ mod tests {
                 ..BlockedByCounts::default()
             }
         );
+    }
+
+    #[test]
+    fn queries_near_a_camera_path_lie_within_reach_of_it() {
+        let (scene, map) = wall_world();
+        let path = [Point3::new(2.0, -1.0, 3.0), Point3::new(2.0, 1.0, 3.0)];
+        let config = QueryConfig {
+            queries: 10,
+            distance: (0.5, 3.0),
+            altitude: (0.0, f64::MAX),
+            ..QueryConfig::default()
+        };
+        let near = |reach| Candidates::NearPath {
+            reference: &map,
+            path: &path,
+            reach,
+        };
+        let queries = draw_queries(&scene, near(1.0), &config).unwrap();
+        assert_eq!(queries.len(), 10);
+        for q in &queries {
+            for p in [q.from, q.to] {
+                assert!(path.iter().any(|c| (p - c).norm() <= 1.0), "{p}");
+            }
+        }
+        assert!(draw_queries(&scene, near(0.0), &config).is_err());
+        assert!(draw_queries(&scene, near(f64::NAN), &config).is_err());
     }
 }

@@ -19,6 +19,29 @@ pub struct FlightOutcome {
     pub failure: Option<FlightFailure>,
     /// For an unsafe start or goal: what blocks it.
     pub blocked_by: Option<BlockingClass>,
+    /// For a path that meets the true world: where, and what the map said there.
+    pub collision: Option<CollisionDetail>,
+}
+
+/// A planned path that meets the true world, explained: the query, the first point where the
+/// vehicle's ball meets an obstacle, what the map said of that point's voxel, and how far the
+/// point lies from the true surface (`plan_collision_details` in the JSON).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CollisionDetail {
+    /// The query's start.
+    pub from: Point3<f64>,
+    /// The query's goal.
+    pub to: Point3<f64>,
+    /// The first point of the path whose ball meets an obstacle.
+    pub point: Point3<f64>,
+    /// The map's class of that point's voxel (`occupied`, `free`, `ambiguous` or `unknown`).
+    pub class: &'static str,
+    /// The map's occupied membership there.
+    pub occupied: f32,
+    /// The map's free membership there.
+    pub free: f32,
+    /// The point's distance to the nearest true surface, metres.
+    pub distance_to_surface: f64,
 }
 
 /// What makes an unsafe start or goal unsafe: the class of its own voxel when that may not be
@@ -148,7 +171,7 @@ impl FailureCounts {
 }
 
 /// Flight figures of one map, as reported in `metrics.json`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FlightSummary {
     /// Start/goal pairs tried.
     pub plan_queries: usize,
@@ -161,6 +184,8 @@ pub struct FlightSummary {
     pub path_length_ratio: Option<f64>,
     /// The failed queries by reason.
     pub plan_failures: FailureCounts,
+    /// Every path that meets the true world, explained.
+    pub plan_collision_details: Vec<CollisionDetail>,
 }
 
 /// The figures of one map's outcomes, with lengths compared to the reference (ground-truth
@@ -183,5 +208,6 @@ pub fn summarize(outcomes: &[FlightOutcome], reference: &[FlightOutcome]) -> Fli
         path_length_ratio: (!ratios.is_empty())
             .then(|| ratios.iter().sum::<f64>() / ratios.len() as f64),
         plan_failures: FailureCounts::count(outcomes),
+        plan_collision_details: outcomes.iter().filter_map(|o| o.collision).collect(),
     }
 }

@@ -124,6 +124,17 @@ pub enum Candidates<'a> {
     /// (vehicle radius plus a voxel diagonal, see `fuzzyvox_plan::CostField`) is free and
     /// safe in it.
     Reference(&'a dyn VoxelMap),
+    /// Voxels a reference map calls free, as [`Candidates::Reference`] takes them, but within
+    /// `reach` metres of a point of `path` (where the camera went) instead of within the
+    /// altitude band: for real footage, whose world frame need not have z up.
+    NearPath {
+        /// The reference map.
+        reference: &'a dyn VoxelMap,
+        /// Where the camera went.
+        path: &'a [Point3<f64>],
+        /// How far from the path candidates may lie, metres.
+        reach: f64,
+    },
     /// Voxel centres drawn uniformly in a horizontal box (`[[x0, y0], [x1, y1]]`), kept when
     /// `connect` finds the truth's path between them (its length becomes
     /// [`FlightQuery::reference_length`]). For flights into space nobody has seen yet.
@@ -147,7 +158,26 @@ pub fn draw_queries(
 ) -> Result<Vec<FlightQuery>> {
     let config = config.validate()?;
     match candidates {
-        Candidates::Reference(reference) => from_reference(world, reference, &config),
+        Candidates::Reference(reference) => {
+            let (low, high) = config.altitude;
+            let in_band = |p: &Point3<f64>| p.z >= low && p.z <= high;
+            from_reference(world, reference, &in_band, &config)
+        }
+        Candidates::NearPath {
+            reference,
+            path,
+            reach,
+        } => {
+            if !(reach.is_finite() && reach > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "reach from the camera path",
+                    value: reach,
+                    expected: "a finite distance > 0 m",
+                });
+            }
+            let near = |p: &Point3<f64>| path.iter().any(|c| (p - c).norm() <= reach);
+            from_reference(world, reference, &near, &config)
+        }
         Candidates::Uniform {
             extent,
             resolution,
@@ -156,9 +186,11 @@ pub fn draw_queries(
     }
 }
 
+/// Pairs of `reference`'s free voxels whose centres `keep` accepts.
 fn from_reference(
     world: &dyn Obstacles,
     reference: &dyn VoxelMap,
+    keep: &dyn Fn(&Point3<f64>) -> bool,
     config: &QueryConfig,
 ) -> Result<Vec<FlightQuery>> {
     let planner = config.planner;
@@ -167,10 +199,7 @@ fn from_reference(
     let mut candidates: Vec<VoxelKey> = reference
         .cells()
         .filter(|&(key, m)| {
-            let z = resolution.center(key).z;
-            z >= config.altitude.0
-                && z <= config.altitude.1
-                && measures.classify(m) == VoxelClass::Free
+            measures.classify(m) == VoxelClass::Free && keep(&resolution.center(key))
         })
         .map(|(key, _)| key)
         .collect();

@@ -10,6 +10,17 @@ pub trait Obstacles: Sync {
     fn distance_to_surface(&self, point: &Point3<f64>) -> f64;
     /// Whether a ball of `radius` metres swept from `a` to `b` meets an obstacle.
     fn meets_swept_ball(&self, a: &Point3<f64>, b: &Point3<f64>, radius: f64) -> bool;
+
+    /// The first point from `a` towards `b`, in steps of a quarter of `radius`, whose ball of
+    /// `radius` meets an obstacle (for a path that [`Obstacles::meets_swept_ball`] said meets
+    /// one); `None` when no step does.
+    fn first_contact(&self, a: &Point3<f64>, b: &Point3<f64>, radius: f64) -> Option<Point3<f64>> {
+        let length = (b - a).norm();
+        let steps = (length / (radius / 4.0).max(1e-3)).ceil().max(1.0) as usize;
+        (0..=steps)
+            .map(|i| a + (b - a) * (i as f64 / steps as f64))
+            .find(|p| self.distance_to_surface(p) < radius)
+    }
 }
 
 /// A simulated scene's real geometry.
@@ -21,6 +32,25 @@ impl Obstacles for Scene {
     fn meets_swept_ball(&self, a: &Point3<f64>, b: &Point3<f64>, radius: f64) -> bool {
         self.intersects_swept_ball(a, b, radius)
     }
+}
+
+/// Where a ball of `radius` swept along the path `waypoints` first meets an obstacle of
+/// `world`, as [`Obstacles::first_contact`] finds it on the first segment that meets one (the
+/// segment's start when the steps find no nearer point); `None` when the path is clear.
+pub fn path_contact(
+    world: &dyn Obstacles,
+    waypoints: &[Point3<f64>],
+    radius: f64,
+) -> Option<Point3<f64>> {
+    let segments: Vec<(&Point3<f64>, &Point3<f64>)> = match waypoints {
+        [] => Vec::new(),
+        [only] => vec![(only, only)],
+        _ => waypoints.windows(2).map(|w| (&w[0], &w[1])).collect(),
+    };
+    segments
+        .into_iter()
+        .find(|(a, b)| world.meets_swept_ball(a, b, radius))
+        .map(|(a, b)| world.first_contact(a, b, radius).unwrap_or(*a))
 }
 
 /// Whether a ball of `radius` swept along the path `waypoints` meets an obstacle of `world`

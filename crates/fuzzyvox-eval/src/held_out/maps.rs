@@ -5,6 +5,7 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
+use super::flights::RealFlights;
 use crate::rgbd::{DepthAgreement, DepthCheckConfig, DepthErrors};
 use fuzzyvox_core::error::Result;
 use fuzzyvox_core::integrate::{DepthFrame, IntegrationOptions};
@@ -31,6 +32,10 @@ pub struct MapCheckReport {
     /// How well the map predicts the held-out depth.
     #[serde(flatten)]
     pub agreement: DepthAgreement,
+    /// Flights planned through the map and checked against the reference map (`mono --plan`);
+    /// `None` (no keys) otherwise.
+    #[serde(flatten)]
+    pub flights: Option<RealFlights>,
 }
 
 /// One map under test, with its timings and its errors on held-out frames.
@@ -64,6 +69,7 @@ impl MapUnderTest {
             counts: view.counts(),
             memory_bytes: view.memory_bytes(),
             agreement: self.errors.summary(resolution),
+            flights: None,
         }
     }
 }

@@ -7,6 +7,7 @@
 //! the built maps.
 
 mod config;
+mod flights;
 mod maps;
 mod mono;
 mod mono_config;
@@ -15,6 +16,7 @@ mod run;
 mod stage;
 
 pub use config::{HeldOutConfig, PriorMap};
+pub use flights::{RealFlightConfig, RealFlights};
 pub use maps::MapCheckReport;
 pub use mono::{DepthStageReport, MonoReport, MonoRun, MonoSeconds, run_mono, run_mono_on};
 pub use mono_config::MonoConfig;

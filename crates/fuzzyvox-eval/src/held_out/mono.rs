@@ -7,14 +7,16 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::flights::{fly_real, reference_map};
 use super::maps::{MapCheckReport, MapUnderTest, check_all, integrate_all};
 use super::mono_config::MonoConfig;
 use super::run::{FolderSplit, HeldOutRun};
 use super::stage::HeldOutStage;
 use crate::depth_stage::{DepthStageErrors, DepthStageSummary};
 use crate::rgbd::HoldoutSplit;
-use fuzzyvox_core::error::Result;
+use fuzzyvox_core::error::{Error, Result};
 use fuzzyvox_core::integrate::IntegrationOptions;
+use fuzzyvox_core::map::VoxelMap;
 use fuzzyvox_io::posed::PosedFolder;
 use fuzzyvox_io::rgbd::read_pose_txt;
 
@@ -170,6 +172,26 @@ pub fn run_mono_on(
         progress(HeldOutStage::RayCasting, done + 1, total);
     }
 
+    let flights = match &config.flights {
+        Some(flights) => {
+            progress(HeldOutStage::Flights, 0, 1);
+            let t = Instant::now();
+            let reference = reference_map(folder, held_out.resolution)?.ok_or(Error::Empty(
+                "sensor depth in the folder (flights are checked against a map of it)",
+            ))?;
+            let cameras: Vec<_> = folder
+                .poses
+                .iter()
+                .map(|p| p.translation.vector.into())
+                .collect();
+            let views: Vec<&dyn VoxelMap> = maps.iter().map(|m| m.map.as_map()).collect();
+            let flown = fly_real(&views, &reference, &cameras, flights)?;
+            seconds.check += t.elapsed().as_secs_f64();
+            progress(HeldOutStage::Flights, 1, 1);
+            Some(flown)
+        }
+        None => None,
+    };
     let counts = stream.counts();
     let mapping = (seconds.read + seconds.depth + seconds.integrate).max(1e-9);
     let report = MonoReport {
@@ -203,7 +225,12 @@ pub fn run_mono_on(
         frames_per_second: split.build.len() as f64 / mapping,
         maps: maps
             .iter()
-            .map(|m| m.report(held_out.operator, held_out.resolution))
+            .enumerate()
+            .map(|(i, m)| {
+                let mut report = m.report(held_out.operator, held_out.resolution);
+                report.flights = flights.as_ref().and_then(|f| f.get(i).cloned());
+                report
+            })
             .collect(),
     };
     Ok(MonoRun {

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use super::config::HeldOutConfig;
+use super::flights::RealFlightConfig;
 use fuzzyvox_core::error::{Error, Result};
 use fuzzyvox_depth::{DepthParams, DepthStream, PairCriteria};
 
@@ -26,6 +27,9 @@ pub struct MonoConfig {
     pub far: f64,
     /// Smallest baseline of a pair (m).
     pub min_baseline: f64,
+    /// Flights through the maps, checked against a reference map of the folder's sensor
+    /// depth; `None`: none.
+    pub flights: Option<RealFlightConfig>,
 }
 
 impl MonoConfig {
@@ -40,6 +44,7 @@ impl MonoConfig {
             near: 0.3,
             far: 8.0,
             min_baseline: 0.05,
+            flights: None,
         }
     }
 
@@ -68,6 +73,9 @@ impl MonoConfig {
                 value: self.far,
                 expected,
             });
+        }
+        if let Some(flights) = &self.flights {
+            flights.validate()?;
         }
         self.stream().map(|_| ())
     }

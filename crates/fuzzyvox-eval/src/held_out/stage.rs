@@ -11,15 +11,19 @@ pub enum HeldOutStage {
     DepthAndMapping,
     /// Ray casting every map into the held-out frames.
     RayCasting,
+    /// Flights planned through every map and checked against the reference (`run_mono` with
+    /// flights).
+    Flights,
 }
 
 impl HeldOutStage {
-    /// A short lower-case label: `integrating`, `depth and mapping` or `ray casting`.
+    /// A short lower-case label: `integrating`, `depth and mapping`, `ray casting` or `flights`.
     pub fn label(self) -> &'static str {
         match self {
             Self::Integrating => "integrating",
             Self::DepthAndMapping => "depth and mapping",
             Self::RayCasting => "ray casting",
+            Self::Flights => "flights",
         }
     }
 }
