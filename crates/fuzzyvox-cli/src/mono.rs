@@ -2,12 +2,14 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::eval::{MapCheckReport, MonoConfig, RealFlightConfig, run_mono_on};
+use fuzzyvox::eval::{
+    MapCheckReport, MonoConfig, RealFlightConfig, run_mono_on, write_held_out_maps,
+};
 use fuzzyvox::io::posed::PosedFolder;
 use fuzzyvox::io::rgbd::read_pose_txt;
 use tracing::info;
 
-use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table, save_all};
+use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table};
 
 /// Map a folder of real posed colour images with the one-camera depth stage, and check the maps
 /// against the sensor depth of frames they have not seen.
@@ -79,7 +81,8 @@ pub struct MonoArgs {
         allow_negative_numbers = true
     )]
     radius: f64,
-    /// Save every map here as MODEL.fvx.
+    /// Write every map here: MODEL.fvx, MODEL-top.png (a top view by height with the camera's
+    /// path) and MODEL.html (its 3D viewer page).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Print one JSON object instead of text.
@@ -126,7 +129,17 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
     .with_context(|| format!("mapping {}", args.dir.display()))?;
     bars.finish();
     if let Some(dir) = &args.out {
-        save_all(&run.maps, dir)?;
+        let cameras: Vec<_> = folder
+            .poses
+            .iter()
+            .map(|p| p.translation.vector.into())
+            .collect();
+        let title = args.dir.file_name().unwrap_or_default().to_string_lossy();
+        for file in write_held_out_maps(dir, &title, &run.maps, &cameras)
+            .with_context(|| format!("writing the maps into {}", dir.display()))?
+        {
+            info!("wrote {}", file.display());
+        }
     }
     let report = &run.report;
     if args.json {

@@ -319,6 +319,15 @@ fn mono_plans_flights_through_every_map_against_a_map_of_the_sensor_depth() {
             "{failures} against {success}"
         );
     }
+    // --out writes each map, its top view and its viewer page with the camera's path.
+    for model in ["logodds", "alpha", "fuzzy"] {
+        let out = root.join("maps");
+        assert!(out.join(format!("{model}.fvx")).is_file());
+        let top = image::open(out.join(format!("{model}-top.png"))).unwrap();
+        assert!(top.width() >= 200 && top.height() >= 200, "{model}");
+        let page = std::fs::read_to_string(out.join(format!("{model}.html"))).unwrap();
+        assert!(page.contains("camera"), "{model}");
+    }
     // The same seed draws the same queries: the same figures again.
     let again = mono(
         &frames,

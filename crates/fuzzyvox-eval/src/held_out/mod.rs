@@ -14,6 +14,7 @@ mod mono_config;
 mod rgbd;
 mod run;
 mod stage;
+mod write;
 
 pub use config::{HeldOutConfig, PriorMap};
 pub use flights::{RealFlightConfig, RealFlights};
@@ -23,3 +24,4 @@ pub use mono_config::MonoConfig;
 pub use rgbd::{RgbdReport, RgbdRun, run_rgbd, run_rgbd_on};
 pub use run::{FolderSplit, HeldOutRun};
 pub use stage::HeldOutStage;
+pub use write::write_held_out_maps;
