@@ -19,7 +19,7 @@ pub enum PlanError {
     #[error("the goal is not safe: {0}")]
     GoalUnsafe(Blocker),
     /// The goal is a voxel the caller asked the planner to avoid
-    /// ([`plan_in_field_avoiding`]).
+    /// ([`plan_in_field_avoiding`](crate::plan_in_field_avoiding)).
     #[error("the goal is one of the voxels the planner was asked to avoid")]
     GoalAvoided,
     /// Start and goal are not connected through traversable voxels.
