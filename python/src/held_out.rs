@@ -1,13 +1,17 @@
 //! The held-out experiments on real data (`fuzzyvox rgbd`, `fuzzyvox mono`) as functions that
 //! return the command's `--json` report as a dict.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use fuzzyvox_core::{AnyMap, Family, MapKind};
-use fuzzyvox_eval::{HeldOutConfig, MonoConfig, PriorMap, RealFlightConfig, run_mono, run_rgbd};
+use fuzzyvox_core::{Family, MapKind};
+use fuzzyvox_eval::{
+    HeldOutConfig, HeldOutRun, MonoConfig, PriorMap, RealFlightConfig, run_mono, run_rgbd,
+    save_held_out_maps,
+};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use serde::Serialize;
 
 use crate::errors::{OrRaise, invalid};
 use crate::scenario::json_to_py;
@@ -109,16 +113,23 @@ fn held_out_config(res: f64, options: &mut Options) -> PyResult<HeldOutConfig> {
     Ok(config)
 }
 
-/// Saves every map as ``DIR/MODEL.fvx``.
-fn save_all(maps: &[AnyMap], dir: &Path) -> fuzzyvox_core::Result<()> {
-    std::fs::create_dir_all(dir).map_err(|source| fuzzyvox_core::Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    for map in maps {
-        map.save(dir.join(format!("{}.fvx", map.kind().name())))?;
-    }
-    Ok(())
+/// Runs `run` with the GIL released, saves its maps into `save` when given, and returns its
+/// report as a dict.
+fn report_of<'py, R: Serialize + Send>(
+    py: Python<'py>,
+    save: Option<PathBuf>,
+    run: impl FnOnce() -> fuzzyvox_core::Result<HeldOutRun<R>> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let run = py
+        .detach(|| {
+            let run = run()?;
+            if let Some(dir) = &save {
+                save_held_out_maps(dir, &run.maps)?;
+            }
+            Ok::<_, fuzzyvox_core::Error>(run)
+        })
+        .or_raise()?;
+    json_to_py(py, &run.report)
 }
 
 /// Runs ``fuzzyvox rgbd``: builds the maps from the sensor depth of the RGB-D folder ``dir``
@@ -141,16 +152,7 @@ pub fn rgbd<'py>(
     let config = held_out_config(res, &mut options)?;
     let save: Option<PathBuf> = options.get("save", None)?;
     options.finish("rgbd")?;
-    let run = py
-        .detach(|| {
-            let run = run_rgbd(&dir, &config, &mut |_, _, _| {})?;
-            if let Some(save) = &save {
-                save_all(&run.maps, save)?;
-            }
-            Ok::<_, fuzzyvox_core::Error>(run)
-        })
-        .or_raise()?;
-    json_to_py(py, &run.report)
+    report_of(py, save, || run_rgbd(&dir, &config, &mut |_, _, _| {}))
 }
 
 /// Runs ``fuzzyvox mono``: streams the posed colour images of ``dir`` (every frame but every
@@ -202,14 +204,5 @@ pub fn mono<'py>(
     let out: Option<PathBuf> = options.get("out", None)?;
     options.finish("mono")?;
     config.validate().or_raise()?;
-    let run = py
-        .detach(|| {
-            let run = run_mono(&dir, &config, &mut |_, _, _| {})?;
-            if let Some(out) = &out {
-                save_all(&run.maps, out)?;
-            }
-            Ok::<_, fuzzyvox_core::Error>(run)
-        })
-        .or_raise()?;
-    json_to_py(py, &run.report)
+    report_of(py, out, || run_mono(&dir, &config, &mut |_, _, _| {}))
 }

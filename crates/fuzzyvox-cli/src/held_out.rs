@@ -1,16 +1,13 @@
 //! What `rgbd` and `mono` share: the options of the maps under test and of their check against
-//! held-out frames of sensor depth, the progress bars of a run, saving its maps and its table.
+//! held-out frames of sensor depth, the progress bars of a run and its table.
 //! The runs themselves are the library's (`fuzzyvox::eval::run_rgbd`, `run_mono`).
-
-use std::path::Path;
 
 use anyhow::Context;
 use clap::Args;
 use fuzzyvox::eval::{HeldOutConfig, HeldOutStage, MapCheckReport, PriorMap};
 use fuzzyvox::map::MapKind;
-use fuzzyvox::{AnyMap, Error, Family};
+use fuzzyvox::{Error, Family};
 use indicatif::ProgressBar;
-use tracing::info;
 
 use super::maps::{ModelArg, PriorArgs};
 use super::progress;
@@ -145,18 +142,6 @@ impl StageBars {
             bar.finish_and_clear();
         }
     }
-}
-
-/// Saves every map as `DIR/MODEL.fvx`.
-pub fn save_all(maps: &[AnyMap], dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    for map in maps {
-        let path = dir.join(format!("{}.fvx", map.kind().name()));
-        map.save(&path)
-            .with_context(|| format!("saving {}", path.display()))?;
-        info!("saved {}", path.display());
-    }
-    Ok(())
 }
 
 /// The reports as a table on standard output.

@@ -2,11 +2,11 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use fuzzyvox::eval::run_rgbd_on;
+use fuzzyvox::eval::{run_rgbd_on, save_held_out_maps};
 use fuzzyvox::io::rgbd::RgbdFolder;
 use tracing::info;
 
-use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table, save_all};
+use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table};
 
 /// Map a folder of real RGB-D frames and check each map against frames it has not seen.
 ///
@@ -61,7 +61,11 @@ pub fn run(args: RgbdArgs) -> anyhow::Result<()> {
         report.split.held_out_frames
     );
     if let Some(dir) = &args.save {
-        save_all(&run.maps, dir)?;
+        for file in save_held_out_maps(dir, &run.maps)
+            .with_context(|| format!("saving the maps into {}", dir.display()))?
+        {
+            info!("saved {}", file.display());
+        }
     }
     if args.json {
         return super::print_json(&serde_json::to_value(report)?);

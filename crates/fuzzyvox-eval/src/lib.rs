@@ -46,7 +46,8 @@ pub use flights::{
 pub use held_out::{
     DepthStageReport, FolderSplit, HeldOutConfig, HeldOutRun, HeldOutStage, MapCheckReport,
     MonoConfig, MonoReport, MonoRun, MonoSeconds, PriorMap, RealFlightConfig, RealFlights,
-    RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on, write_held_out_maps,
+    RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on, save_held_out_maps,
+    write_held_out_maps,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};

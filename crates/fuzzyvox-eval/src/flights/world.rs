@@ -36,31 +36,26 @@ impl Obstacles for Scene {
 
 /// Where a ball of `radius` swept along the path `waypoints` first meets an obstacle of
 /// `world`, as [`Obstacles::first_contact`] finds it on the first segment that meets one (the
-/// segment's start when the steps find no nearer point); `None` when the path is clear.
+/// segment's start when the steps find no nearer point); `None` when the path is clear. A
+/// one-point path is checked as a ball at that point; an empty path meets nothing.
 pub fn path_contact(
     world: &dyn Obstacles,
     waypoints: &[Point3<f64>],
     radius: f64,
 ) -> Option<Point3<f64>> {
-    let segments: Vec<(&Point3<f64>, &Point3<f64>)> = match waypoints {
-        [] => Vec::new(),
-        [only] => vec![(only, only)],
-        _ => waypoints.windows(2).map(|w| (&w[0], &w[1])).collect(),
+    let single = match waypoints {
+        [only] => Some((only, only)),
+        _ => None,
     };
-    segments
+    single
         .into_iter()
+        .chain(waypoints.windows(2).map(|w| (&w[0], &w[1])))
         .find(|(a, b)| world.meets_swept_ball(a, b, radius))
         .map(|(a, b)| world.first_contact(a, b, radius).unwrap_or(*a))
 }
 
 /// Whether a ball of `radius` swept along the path `waypoints` meets an obstacle of `world`
-/// (a one-point path is checked as a ball at that point; an empty path meets nothing).
+/// ([`path_contact`] finds where).
 pub fn path_collides(world: &dyn Obstacles, waypoints: &[Point3<f64>], radius: f64) -> bool {
-    match waypoints {
-        [] => false,
-        [only] => world.meets_swept_ball(only, only, radius),
-        _ => waypoints
-            .windows(2)
-            .any(|w| world.meets_swept_ball(&w[0], &w[1], radius)),
-    }
+    path_contact(world, waypoints, radius).is_some()
 }

@@ -24,4 +24,4 @@ pub use mono_config::MonoConfig;
 pub use rgbd::{RgbdReport, RgbdRun, run_rgbd, run_rgbd_on};
 pub use run::{FolderSplit, HeldOutRun};
 pub use stage::HeldOutStage;
-pub use write::write_held_out_maps;
+pub use write::{save_held_out_maps, write_held_out_maps};

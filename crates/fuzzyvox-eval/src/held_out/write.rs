@@ -10,6 +10,21 @@ use fuzzyvox_figure::{Overlay, View, ViewColor, ViewSpec, save_png, view_figure}
 use fuzzyvox_view::{PagePath, PathKind, ViewerOptions, write_viewer_page};
 use nalgebra::Point3;
 
+/// Saves every map of a run into `dir` (made when missing) as `MODEL.fvx`; returns the files.
+pub fn save_held_out_maps(dir: &Path, maps: &[AnyMap]) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).map_err(|source| fuzzyvox_core::error::Error::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    maps.iter()
+        .map(|map| {
+            let native = dir.join(format!("{}.fvx", map.kind().name()));
+            map.save(&native)?;
+            Ok(native)
+        })
+        .collect()
+}
+
 /// Writes every map of a run into `dir` (made when missing): `MODEL.fvx`, `MODEL-top.png` (its
 /// occupied voxels from above, coloured by height, with the camera's path, as `fuzzyvox export
 /// --png --view top --color height` draws them) and `MODEL.html` (its 3D viewer page with the
@@ -20,16 +35,9 @@ pub fn write_held_out_maps(
     maps: &[AnyMap],
     cameras: &[Point3<f64>],
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|source| fuzzyvox_core::error::Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let mut files = Vec::new();
+    let mut files = save_held_out_maps(dir, maps)?;
     for map in maps {
         let name = map.kind().name();
-        let native = dir.join(format!("{name}.fvx"));
-        map.save(&native)?;
-        files.push(native);
 
         let top = dir.join(format!("{name}-top.png"));
         let camera = Overlay {
