@@ -99,6 +99,8 @@ pub fn flag_error(error: Error) -> anyhow::Error {
             "near" => "near",
             "far" => "far",
             "min_baseline" => "min-baseline",
+            "flights to plan" => "plan",
+            "vehicle_radius" => "radius",
             _ => return None,
         };
         Some(format!("--{flag} {value}"))
