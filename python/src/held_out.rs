@@ -104,6 +104,7 @@ fn held_out_config(res: f64, options: &mut Options) -> PyResult<HeldOutConfig> {
         stop_at_ambiguous: options.get("stop_at_ambiguous", defaults.stop_at_ambiguous)?,
         operator,
         cuts: options.get("cuts", defaults.cuts)?,
+        evidence: defaults.evidence,
         prior: prior.map(|path| PriorMap {
             path,
             confidence: prior_confidence,
@@ -177,13 +178,18 @@ pub fn mono<'py>(
     let held_out = held_out_config(res, &mut options)?;
     let defaults = MonoConfig::new(res);
     let config = MonoConfig {
-        held_out,
+        // The depth stage's checked images take the evidence model made for them.
+        held_out: HeldOutConfig {
+            evidence: defaults.held_out.evidence,
+            ..held_out
+        },
         views: options.get("views", defaults.views)?,
         trajectory: options.get("trajectory", None)?,
         extrinsics: options.get("extrinsics", None)?,
         near: options.get("near", defaults.near)?,
         far: options.get("far", defaults.far)?,
         min_baseline: options.get("min_baseline", defaults.min_baseline)?,
+        consistency: defaults.consistency,
         flights: None,
     };
     let plan: Option<usize> = options.get("plan", None)?;

@@ -70,6 +70,7 @@ impl MapCheckArgs {
             stop_at_ambiguous: self.stop_at_ambiguous,
             operator,
             cuts: self.cuts,
+            evidence: HeldOutConfig::new(self.res).evidence,
             prior: self.prior.prior.clone().map(|path| PriorMap {
                 path,
                 confidence: self.prior.prior_confidence,
@@ -99,6 +100,7 @@ pub fn flag_error(error: Error) -> anyhow::Error {
             "near" => "near",
             "far" => "far",
             "min_baseline" => "min-baseline",
+            "min_agreeing" => "min-agreeing",
             "flights to plan" => "plan",
             "vehicle_radius" => "radius",
             _ => return None,

@@ -2,8 +2,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use fuzzyvox::depth::ConsistencyParams;
 use fuzzyvox::eval::{
-    MapCheckReport, MonoConfig, RealFlightConfig, run_mono_on, write_held_out_maps,
+    HeldOutConfig, MapCheckReport, MonoConfig, RealFlightConfig, run_mono_on, write_held_out_maps,
 };
 use fuzzyvox::io::posed::PosedFolder;
 use fuzzyvox::io::rgbd::read_pose_txt;
@@ -23,8 +24,13 @@ use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table};
 /// Frames stream through pair selection and the depth stage: each frame is paired with the
 /// earlier frame of the best `Q_ABD` (baseline between --min-baseline and 2 m, within 2 s,
 /// views within 20°); sideways pairs are rectified and matched along rows, pairs moving along
-/// the view by plane sweep, with `--views N` earlier views at once. Every map integrates the
-/// same interval depth images. Every K-th frame (`--holdout K`) never reaches the depth stage.
+/// the view by plane sweep, with `--views N` earlier views at once. Each depth image is then
+/// checked against its neighbours in the stream (`--consistency N` on each side): a pixel's
+/// depth, carried into a neighbouring image, must land on that image's own depth (within 3%)
+/// in at least `--min-agreeing K` of them, or it is dropped; kept pixels take the mean of the
+/// agreeing depths, an interval of at least ±5%, and a confidence scaled by the share of
+/// neighbours that agree rather than see through. Every map integrates the same checked
+/// images. Every K-th frame (`--holdout K`) never reaches the depth stage.
 ///
 /// Sensor depth (`frame-N.depth.png`), when present, is never used for mapping: it measures the
 /// depth stage (the median relative error of `P0` and how often the sensor's depth lies inside
@@ -33,7 +39,7 @@ use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table};
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
     fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04\n  \
-    fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04 --views 3 --json\n  \
+    fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04 --views 2 --consistency 0 --json\n  \
     fuzzyvox mono --dir DIR --res 0.05 --trajectory poses.tum --model fuzzy --out maps/\n  \
     fuzzyvox mono --dir ../shared/data/rgbd-hololens-000 --res 0.05 --plan 50 --json")]
 pub struct MonoArgs {
@@ -43,8 +49,15 @@ pub struct MonoArgs {
     #[command(flatten)]
     maps: MapCheckArgs,
     /// Views matched at once for each depth image (2: pairs).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=17))]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(2..=17))]
     views: u32,
+    /// Check each depth image against this many neighbouring depth images on each side: a
+    /// pixel keeps its depth only where enough of them agree (0: no check).
+    #[arg(long, default_value_t = 4, value_name = "N")]
+    consistency: usize,
+    /// Neighbouring depth images that must agree with a pixel for it to keep its depth.
+    #[arg(long, default_value_t = 2, value_name = "K")]
+    min_agreeing: usize,
     /// Poses from a TUM trajectory (`timestamp tx ty tz qx qy qz qw` per line, the k-th pose
     /// for the k-th frame) instead of `frame-N.pose.txt`.
     #[arg(long, value_name = "FILE")]
@@ -91,14 +104,24 @@ pub struct MonoArgs {
 }
 
 pub fn run(args: MonoArgs) -> anyhow::Result<()> {
+    let defaults = MonoConfig::new(args.maps.res);
     let config = MonoConfig {
-        held_out: args.maps.config()?,
+        // The depth stage's checked images take the evidence model made for them.
+        held_out: HeldOutConfig {
+            evidence: defaults.held_out.evidence,
+            ..args.maps.config()?
+        },
         views: args.views,
         trajectory: args.trajectory.clone(),
         extrinsics: args.extrinsics.clone(),
         near: args.near,
         far: args.far,
         min_baseline: args.min_baseline,
+        consistency: ConsistencyParams {
+            neighbours: args.consistency,
+            min_agreeing: args.min_agreeing,
+            ..defaults.consistency
+        },
         flights: args.plan.map(|queries| RealFlightConfig {
             seed: args.seed,
             vehicle_radius: args.radius,

@@ -5,6 +5,7 @@
 //! [`ViewWindow`]). See `docs/depth.md`.
 
 mod census;
+mod consistency;
 mod frame;
 mod interval;
 mod matching;
@@ -22,6 +23,9 @@ mod views;
 pub use census::{
     CENSUS_BITS, CENSUS_HEIGHT, CENSUS_MAX_COST, CENSUS_WIDTH, CensusCode, CensusImage,
     census_transform,
+};
+pub use consistency::{
+    ConsistencyCounts, ConsistencyFilter, ConsistencyParams, ConsistencyVotes, check_consistency,
 };
 pub use frame::{PairCriteria, PairSelector, SelectedPair};
 pub use fuzzyvox_core::error::UnrectifiableReason;

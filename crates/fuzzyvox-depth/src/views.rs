@@ -5,6 +5,7 @@ use fuzzyvox_core::image::Frame;
 
 use super::pipeline::{DepthParams, DepthResult, depth_from_pair, depth_from_views};
 use super::sweep::{MAX_SWEEP_VIEWS, PLANE_COUNT};
+use crate::MAX_DISPARITIES;
 use fuzzyvox_core::error::{Error, Result};
 
 /// Camera positions closer than this (metres) count as one and add no baseline.
@@ -128,8 +129,42 @@ impl ViewWindow {
                 result => return (result, dropped),
             }
         }
-        (depth_from_pair(reference, other, params), dropped)
+        (pair_within_planes(reference, other, params), dropped)
     }
+}
+
+/// [`depth_from_pair`], and when the pair's sweep over the depth range would need more planes
+/// than a sweep has (a long baseline along the view), the same pair swept over a shorter range:
+/// the near end moved out until the planes fit. Pixels nearer than that get no depth (or are
+/// left to the consistency check), instead of the whole frame getting none.
+fn pair_within_planes(
+    reference: &Frame,
+    other: &Frame,
+    params: &DepthParams,
+) -> Result<DepthResult> {
+    let mut params = params.clone();
+    let mut result = depth_from_pair(reference, other, &params);
+    // Each try shrinks the inverse-depth span by the planes' overshoot, and at least by half:
+    // the image motion per unit of inverse depth is largest near the camera, so the planes
+    // needed fall faster than the span once the nearest depths go.
+    for _ in 0..12 {
+        let needed = match &result {
+            Err(Error::InvalidParameter { name, value, .. }) if *name == PLANE_COUNT => *value,
+            _ => break,
+        };
+        let Some((near, far)) = params.depth_range else {
+            break;
+        };
+        let inverse_far = if far.is_finite() { 1.0 / far } else { 0.0 };
+        let fit = f64::from(MAX_DISPARITIES - 24) / (needed - 1.0).max(1.0);
+        let inverse_near = inverse_far + (1.0 / near - inverse_far) * fit.min(0.5);
+        if !(inverse_near.is_finite() && inverse_near > inverse_far) {
+            break;
+        }
+        params.depth_range = Some((1.0 / inverse_near, far));
+        result = depth_from_pair(reference, other, &params);
+    }
+    result
 }
 
 #[cfg(test)]
@@ -155,6 +190,24 @@ mod tests {
         let pose =
             Isometry3::from_parts(Translation3::new(x, 0.0, 0.0), UnitQuaternion::identity());
         Frame::new(image, k, pose, x).unwrap()
+    }
+
+    /// A frame at `z` on the optical axis, looking along +z at a textured wall at z = 5 m.
+    fn forward(z: f64) -> Frame {
+        let k = PinholeIntrinsics::new(64, 48, 60.0, 60.0, 31.5, 23.5).unwrap();
+        let pixels = (0..48)
+            .flat_map(|v| {
+                (0..64).map(move |u| {
+                    let scale = (5.0 - z) / 60.0;
+                    let (x, y) = ((f64::from(u) - 31.5) * scale, (f64::from(v) - 23.5) * scale);
+                    ((x * 9.0).sin() * (y * 7.0).cos() * 0.4 + 0.5) as f32
+                })
+            })
+            .collect();
+        let image = GrayImage::new(64, 48, pixels).unwrap();
+        let pose =
+            Isometry3::from_parts(Translation3::new(0.0, 0.0, z), UnitQuaternion::identity());
+        Frame::new(image, k, pose, z).unwrap()
     }
 
     fn params() -> DepthParams {
@@ -212,6 +265,46 @@ mod tests {
         let result = window.depth(frame(0.1), frame(0.0), &params).unwrap();
         assert_eq!(result.views, 2);
         assert_eq!(window.views_dropped(), 1);
+    }
+
+    #[test]
+    fn a_pair_that_needs_too_many_planes_is_swept_over_a_shorter_range() {
+        // Moving 0.3 m towards the wall, a sweep from 0.5 mm to 1 km needs more planes than a
+        // sweep has: the near end moves out until it fits, and the wall, 4.7 m away, still
+        // gets depth about as a sweep over a sensible range gives it.
+        let params = DepthParams {
+            depth_range: Some((0.0005, 1000.0)),
+            ..params()
+        };
+        let error = depth_from_pair(&forward(0.3), &forward(0.0), &params).unwrap_err();
+        assert!(matches!(error, Error::InvalidParameter { name, .. } if name == PLANE_COUNT));
+        let depths = |result: DepthResult| -> Vec<f32> {
+            let mut depths: Vec<f32> = result
+                .frame
+                .image()
+                .depth()
+                .iter()
+                .copied()
+                .filter(|d| d.is_finite())
+                .collect();
+            depths.sort_by(f32::total_cmp);
+            depths
+        };
+        let mut window = ViewWindow::new(2).unwrap();
+        let shorter = depths(window.depth(forward(0.3), forward(0.0), &params).unwrap());
+        let sensible = DepthParams {
+            depth_range: Some((1.0, 20.0)),
+            ..params.clone()
+        };
+        let plain = depths(depth_from_pair(&forward(0.3), &forward(0.0), &sensible).unwrap());
+        assert!(
+            shorter.len() >= plain.len() / 2,
+            "{} of {}",
+            shorter.len(),
+            plain.len()
+        );
+        let median = shorter[shorter.len() / 2];
+        assert!((median - 4.7).abs() < 0.2 * 4.7, "median depth {median}");
     }
 
     #[test]

@@ -44,10 +44,10 @@ pub use flights::{
     QueryConfig, draw_queries, path_collides, path_contact, plan_queries, summarize,
 };
 pub use held_out::{
-    DepthStageReport, FolderSplit, HeldOutConfig, HeldOutRun, HeldOutStage, MapCheckReport,
-    MonoConfig, MonoReport, MonoRun, MonoSeconds, PriorMap, RealFlightConfig, RealFlights,
-    RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on, save_held_out_maps,
-    write_held_out_maps,
+    ConsistencyReport, DepthStageReport, FolderSplit, HeldOutConfig, HeldOutRun, HeldOutStage,
+    MapCheckReport, MonoConfig, MonoReport, MonoRun, MonoSeconds, PriorMap, RealFlightConfig,
+    RealFlights, RgbdReport, RgbdRun, run_mono, run_mono_on, run_rgbd, run_rgbd_on,
+    save_held_out_maps, write_held_out_maps,
 };
 pub use metrics::{MapMetrics, evaluate};
 pub use report::{file_stem, markdown, report_html, write_experiment};

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use crate::rgbd::DepthCheckConfig;
 use fuzzyvox_core::error::{Error, Result, finite};
+use fuzzyvox_core::integrate::EvidenceModel;
 use fuzzyvox_core::map::{AnyMap, MapKind, MapOptions};
 use fuzzyvox_core::ops::Family;
 
@@ -38,6 +39,9 @@ pub struct HeldOutConfig {
     pub operator: Family,
     /// The alpha-cut map's number of confidence cuts.
     pub cuts: u32,
+    /// The fuzzy map's evidence model: the dual model for sensor depth,
+    /// [`EvidenceModel::confirmed`] for the depth stage's checked images ([`MonoConfig::new`](super::MonoConfig::new)).
+    pub evidence: EvidenceModel,
     /// A prior map for the fuzzy map (only when the fuzzy model is the only one).
     pub prior: Option<PriorMap>,
 }
@@ -55,6 +59,7 @@ impl HeldOutConfig {
             stop_at_ambiguous: false,
             operator: Family::Product,
             cuts: 10,
+            evidence: EvidenceModel::dual(),
             prior: None,
         }
     }
@@ -76,12 +81,12 @@ impl HeldOutConfig {
         }
     }
 
-    /// How the maps are set up beyond their resolution (the dual evidence model).
+    /// How the maps are set up beyond their resolution.
     pub fn map_options(&self) -> MapOptions {
         MapOptions {
             operator: self.operator,
             cuts: self.cuts,
-            ..MapOptions::default()
+            evidence: self.evidence,
         }
     }
 

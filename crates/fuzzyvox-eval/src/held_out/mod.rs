@@ -19,7 +19,9 @@ mod write;
 pub use config::{HeldOutConfig, PriorMap};
 pub use flights::{RealFlightConfig, RealFlights};
 pub use maps::MapCheckReport;
-pub use mono::{DepthStageReport, MonoReport, MonoRun, MonoSeconds, run_mono, run_mono_on};
+pub use mono::{
+    ConsistencyReport, DepthStageReport, MonoReport, MonoRun, MonoSeconds, run_mono, run_mono_on,
+};
 pub use mono_config::MonoConfig;
 pub use rgbd::{RgbdReport, RgbdRun, run_rgbd, run_rgbd_on};
 pub use run::{FolderSplit, HeldOutRun};

@@ -15,8 +15,10 @@ use super::stage::HeldOutStage;
 use crate::depth_stage::{DepthStageErrors, DepthStageSummary};
 use crate::rgbd::HoldoutSplit;
 use fuzzyvox_core::error::{Error, Result};
+use fuzzyvox_core::integrate::DepthFrame;
 use fuzzyvox_core::integrate::IntegrationOptions;
 use fuzzyvox_core::map::VoxelMap;
+use fuzzyvox_depth::ConsistencyFilter;
 use fuzzyvox_io::posed::PosedFolder;
 use fuzzyvox_io::rgbd::read_pose_txt;
 
@@ -30,6 +32,19 @@ pub struct DepthStageReport {
     pub seconds: f64,
     /// The depth stage's share of the mapping time (reading, depth stage, integration).
     pub share_of_mapping_time: f64,
+}
+
+/// What the consistency check did (see [`fuzzyvox_depth::check_consistency`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ConsistencyReport {
+    /// Neighbouring depth images checked on each side (0: no check).
+    pub neighbours: usize,
+    /// Agreeing neighbours a pixel needed.
+    pub min_agreeing: usize,
+    /// Pixels with depth before the check.
+    pub pixels_checked: usize,
+    /// Of those, the pixels kept.
+    pub pixels_kept: usize,
 }
 
 /// Where a mono run's time went (s).
@@ -69,6 +84,8 @@ pub struct MonoReport {
     pub multi_view: usize,
     /// Earlier views left out because they needed too many planes.
     pub views_dropped: usize,
+    /// The check of each depth image against its neighbours.
+    pub consistency: ConsistencyReport,
     /// Build frames without a depth image, by reason.
     pub skipped: BTreeMap<String, usize>,
     /// The depth stage against sensor depth.
@@ -129,6 +146,7 @@ pub fn run_mono_on(
         max_range: Some(config.far),
     };
     let mut stage = DepthStageErrors::default();
+    let mut consistency = ConsistencyFilter::new(config.consistency)?;
     let mut seconds = MonoSeconds::default();
     let total = split.build.len();
     progress(HeldOutStage::DepthAndMapping, 0, total);
@@ -151,13 +169,33 @@ pub fn run_mono_on(
             depth.scale_confidence(weight)?;
         }
         let t = Instant::now();
-        if let Some(sensor) = folder.read_sensor_depth(position)? {
-            stage.add(&depth, &sensor);
+        let checked = consistency.push(position, depth)?;
+        seconds.depth += t.elapsed().as_secs_f64();
+        for (position, depth) in checked {
+            add_depth(
+                folder,
+                position,
+                &depth,
+                &mut maps,
+                &mut stage,
+                &mut seconds,
+                &options,
+            )?;
         }
-        seconds.check += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        integrate_all(&mut maps, &depth, &options)?;
-        seconds.integrate += t.elapsed().as_secs_f64();
+    }
+    let t = Instant::now();
+    let checked = consistency.finish()?;
+    seconds.depth += t.elapsed().as_secs_f64();
+    for (position, depth) in checked {
+        add_depth(
+            folder,
+            position,
+            &depth,
+            &mut maps,
+            &mut stage,
+            &mut seconds,
+            &options,
+        )?;
     }
     let total = split.held_out.len();
     progress(HeldOutStage::RayCasting, 0, total);
@@ -211,6 +249,12 @@ pub fn run_mono_on(
         swept: counts.swept,
         multi_view: counts.multi_view,
         views_dropped: stream.views_dropped(),
+        consistency: ConsistencyReport {
+            neighbours: config.consistency.neighbours,
+            min_agreeing: config.consistency.min_agreeing,
+            pixels_checked: consistency.counts().checked,
+            pixels_kept: consistency.counts().kept,
+        },
         skipped: counts
             .skipped
             .iter()
@@ -237,4 +281,26 @@ pub fn run_mono_on(
         report,
         maps: maps.into_iter().map(|m| m.map).collect(),
     })
+}
+
+/// Measures one checked depth image against the frame's sensor depth, when it has one, and
+/// integrates it into every map.
+fn add_depth(
+    folder: &PosedFolder,
+    position: usize,
+    depth: &DepthFrame,
+    maps: &mut [MapUnderTest],
+    stage: &mut DepthStageErrors,
+    seconds: &mut MonoSeconds,
+    options: &IntegrationOptions,
+) -> Result<()> {
+    let t = Instant::now();
+    if let Some(sensor) = folder.read_sensor_depth(position)? {
+        stage.add(depth, &sensor);
+    }
+    seconds.check += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    integrate_all(maps, depth, options)?;
+    seconds.integrate += t.elapsed().as_secs_f64();
+    Ok(())
 }

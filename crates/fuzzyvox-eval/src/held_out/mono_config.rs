@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use super::config::HeldOutConfig;
 use super::flights::RealFlightConfig;
 use fuzzyvox_core::error::{Error, Result};
-use fuzzyvox_depth::{DepthParams, DepthStream, PairCriteria};
+use fuzzyvox_core::integrate::EvidenceModel;
+use fuzzyvox_depth::{ConsistencyParams, DepthParams, DepthStream, PairCriteria};
 
 /// The settings of [`super::run_mono`].
 #[derive(Clone, Debug, PartialEq)]
@@ -27,23 +28,32 @@ pub struct MonoConfig {
     pub far: f64,
     /// Smallest baseline of a pair (m).
     pub min_baseline: f64,
+    /// The check of each depth image against its neighbours in the stream.
+    pub consistency: ConsistencyParams,
     /// Flights through the maps, checked against a reference map of the folder's sensor
     /// depth; `None`: none.
     pub flights: Option<RealFlightConfig>,
 }
 
 impl MonoConfig {
-    /// The command's defaults at `resolution` metres: [`HeldOutConfig::new`], pairs, poses
-    /// from `pose.txt`, depth searched from 0.3 to 8 m, baselines from 5 cm.
+    /// The command's defaults at `resolution` metres: [`HeldOutConfig::new`] with the evidence
+    /// model for confirmed depth ([`EvidenceModel::confirmed`]), three views per depth image,
+    /// each image checked against four neighbours on each side
+    /// ([`ConsistencyParams::default`]), poses from `pose.txt`, depth searched from 0.3 to
+    /// 8 m, baselines from 5 cm.
     pub fn new(resolution: f64) -> Self {
         Self {
-            held_out: HeldOutConfig::new(resolution),
-            views: 2,
+            held_out: HeldOutConfig {
+                evidence: EvidenceModel::confirmed(),
+                ..HeldOutConfig::new(resolution)
+            },
+            views: 3,
             trajectory: None,
             extrinsics: None,
             near: 0.3,
             far: 8.0,
             min_baseline: 0.05,
+            consistency: ConsistencyParams::default(),
             flights: None,
         }
     }
@@ -74,6 +84,7 @@ impl MonoConfig {
                 expected,
             });
         }
+        self.consistency.validate()?;
         if let Some(flights) = &self.flights {
             flights.validate()?;
         }
