@@ -250,7 +250,9 @@ class RgbdOptions(HeldOutOptions, total=False):
     save: Optional[_Path]
 
 class MonoOptions(HeldOutOptions, total=False):
-    views: int  # 2
+    views: int  # 3
+    consistency: int  # 4
+    min_agreeing: int  # 2
     trajectory: Optional[_Path]
     extrinsics: Optional[_Path]
     near: float  # 0.3

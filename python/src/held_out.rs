@@ -189,7 +189,12 @@ pub fn mono<'py>(
         near: options.get("near", defaults.near)?,
         far: options.get("far", defaults.far)?,
         min_baseline: options.get("min_baseline", defaults.min_baseline)?,
-        consistency: defaults.consistency,
+        consistency: {
+            let mut check = defaults.consistency;
+            check.neighbours = options.get("consistency", check.neighbours)?;
+            check.min_agreeing = options.get("min_agreeing", check.min_agreeing)?;
+            check
+        },
         flights: None,
     };
     let plan: Option<usize> = options.get("plan", None)?;

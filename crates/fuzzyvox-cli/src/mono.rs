@@ -185,6 +185,18 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
     for (reason, n) in &report.skipped {
         println!("  {n} frame(s) without depth: {reason}");
     }
+    let check = &report.consistency;
+    if check.neighbours > 0 {
+        println!(
+            "consistency check ({} neighbours each side, {} agreeing needed): kept {} of {} \
+             pixels ({:.0}%)",
+            check.neighbours,
+            check.min_agreeing,
+            check.pixels_kept,
+            check.pixels_checked,
+            100.0 * check.pixels_kept as f64 / check.pixels_checked.max(1) as f64,
+        );
+    }
     let stage = &report.depth_stage;
     println!(
         "depth stage against sensor depth: {} pixels, median relative error {:.3} (most confident \

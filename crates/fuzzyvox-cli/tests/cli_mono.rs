@@ -392,12 +392,43 @@ fn mono_on_real_frames_reports_the_depth_stage() {
             .ends_with("color-intrinsics.txt")
     );
     let stage = &report["depth_stage"];
-    assert!(stage["pixels"].as_u64().unwrap() > 100_000, "{stage}");
-    // The confidence ranks the depth: the confident half is more accurate than all pixels.
+    assert!(stage["pixels"].as_u64().unwrap() > 50_000, "{stage}");
+    // The consistency check kept part of the depth, and what it kept is more accurate than the
+    // unchecked depth of the same frames.
+    let check = &report["consistency"];
+    assert_eq!(check["neighbours"], 4);
+    let (kept, checked) = (
+        check["pixels_kept"].as_u64().unwrap(),
+        check["pixels_checked"].as_u64().unwrap(),
+    );
+    assert!(kept > 0 && kept < checked, "{check}");
+    let unchecked = json(&fuzzyvox(&[
+        "mono",
+        "--dir",
+        dir.to_str().unwrap(),
+        "--res",
+        "0.05",
+        "--model",
+        "logodds",
+        "--pixel-step",
+        "4",
+        "--consistency",
+        "0",
+        "--views",
+        "2",
+        "--json",
+    ]));
+    let raw = &unchecked["depth_stage"];
+    assert_eq!(unchecked["consistency"]["pixels_checked"], 0);
     assert!(
-        stage["median_rel_error_top50"].as_f64().unwrap()
-            < stage["median_rel_error"].as_f64().unwrap(),
-        "{stage}"
+        stage["median_rel_error"].as_f64().unwrap() < raw["median_rel_error"].as_f64().unwrap(),
+        "checked {stage}, unchecked {raw}"
+    );
+    // Unchecked pairs: the confidence ranks the depth, the confident half being more accurate
+    // than all pixels.
+    assert!(
+        raw["median_rel_error_top50"].as_f64().unwrap() < raw["median_rel_error"].as_f64().unwrap(),
+        "{raw}"
     );
     assert!(report["frames_per_second"].as_f64().unwrap() > 0.0);
 }

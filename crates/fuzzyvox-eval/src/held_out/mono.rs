@@ -18,7 +18,7 @@ use fuzzyvox_core::error::{Error, Result};
 use fuzzyvox_core::integrate::DepthFrame;
 use fuzzyvox_core::integrate::IntegrationOptions;
 use fuzzyvox_core::map::VoxelMap;
-use fuzzyvox_depth::ConsistencyFilter;
+use fuzzyvox_depth::{ConsistencyFilter, ConsistencyParams};
 use fuzzyvox_io::posed::PosedFolder;
 use fuzzyvox_io::rgbd::read_pose_txt;
 
@@ -146,7 +146,11 @@ pub fn run_mono_on(
         max_range: Some(config.far),
     };
     let mut stage = DepthStageErrors::default();
-    let mut consistency = ConsistencyFilter::new(config.consistency)?;
+    // The check drops depths at the far end of the search (see `ConsistencyParams::search_far`).
+    let mut consistency = ConsistencyFilter::new(ConsistencyParams {
+        search_far: Some(config.far),
+        ..config.consistency
+    })?;
     let mut seconds = MonoSeconds::default();
     let total = split.build.len();
     progress(HeldOutStage::DepthAndMapping, 0, total);
