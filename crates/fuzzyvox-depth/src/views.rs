@@ -17,7 +17,9 @@ const SAME_POSITION: f64 = 1e-6;
 /// `views - 2` earlier positions, newest first, by a multiple-baseline plane sweep; with no
 /// earlier position (the first pair, or `views == 2`) the pair is matched on its own by
 /// [`depth_from_pair`]. Earlier positions are left out, oldest first, while the longest baseline
-/// would need more planes than a sweep has (see [`DepthResult::views`] for how many were used).
+/// would need more planes than a sweep has (see [`DepthResult::views`] for how many were used);
+/// a pair that alone needs too many planes (a long baseline along the view) is swept over a
+/// shorter range, its near end moved out until the planes fit, instead of giving no depth.
 /// Both frames of every pair are remembered, whether or not the depth stage could use the pair.
 #[derive(Clone, Debug)]
 pub struct ViewWindow {
