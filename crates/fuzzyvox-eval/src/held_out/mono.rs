@@ -175,32 +175,26 @@ pub fn run_mono_on(
         let t = Instant::now();
         let checked = consistency.push(position, depth)?;
         seconds.depth += t.elapsed().as_secs_f64();
-        for (position, depth) in checked {
-            add_depth(
-                folder,
-                position,
-                &depth,
-                &mut maps,
-                &mut stage,
-                &mut seconds,
-                &options,
-            )?;
-        }
-    }
-    let t = Instant::now();
-    let checked = consistency.finish()?;
-    seconds.depth += t.elapsed().as_secs_f64();
-    for (position, depth) in checked {
-        add_depth(
+        add_checked(
             folder,
-            position,
-            &depth,
+            checked,
             &mut maps,
             &mut stage,
             &mut seconds,
             &options,
         )?;
     }
+    let t = Instant::now();
+    let checked = consistency.finish()?;
+    seconds.depth += t.elapsed().as_secs_f64();
+    add_checked(
+        folder,
+        checked,
+        &mut maps,
+        &mut stage,
+        &mut seconds,
+        &options,
+    )?;
     let total = split.held_out.len();
     progress(HeldOutStage::RayCasting, 0, total);
     let mut checked = 0;
@@ -287,24 +281,25 @@ pub fn run_mono_on(
     })
 }
 
-/// Measures one checked depth image against the frame's sensor depth, when it has one, and
-/// integrates it into every map.
-fn add_depth(
+/// Measures checked depth images (each with its frame's position in the folder) against their
+/// frames' sensor depth, where there is some, and integrates them into every map.
+fn add_checked(
     folder: &PosedFolder,
-    position: usize,
-    depth: &DepthFrame,
+    checked: Vec<(usize, DepthFrame)>,
     maps: &mut [MapUnderTest],
     stage: &mut DepthStageErrors,
     seconds: &mut MonoSeconds,
     options: &IntegrationOptions,
 ) -> Result<()> {
-    let t = Instant::now();
-    if let Some(sensor) = folder.read_sensor_depth(position)? {
-        stage.add(depth, &sensor);
+    for (position, depth) in checked {
+        let t = Instant::now();
+        if let Some(sensor) = folder.read_sensor_depth(position)? {
+            stage.add(&depth, &sensor);
+        }
+        seconds.check += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        integrate_all(maps, &depth, options)?;
+        seconds.integrate += t.elapsed().as_secs_f64();
     }
-    seconds.check += t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    integrate_all(maps, depth, options)?;
-    seconds.integrate += t.elapsed().as_secs_f64();
     Ok(())
 }
