@@ -192,6 +192,16 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         report.rejected_pairs,
         report.truth_occupied
     );
+    if let Some(stage) = &report.depth_stage {
+        println!(
+            "depth stage on {} sampled depth images against the true depth: median relative \
+             error {:.3} (90th percentile {:.3}), true depth inside [P-, P+] {:.2}",
+            stage.images,
+            stage.median_rel_error,
+            stage.rel_error_quantiles.p90,
+            stage.interval_coverage
+        );
+    }
     println!(
         "{:<16} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9}",
         "map", "precision", "recall", "F1", "holes", "spurious", "chamfer"

@@ -58,6 +58,17 @@ fn eval_wall_reports_every_map_after_each_phase_with_flights_and_figures() {
         assert!(map["after_strafe"]["occupied_f1"].is_number(), "{name}");
         assert_eq!(map["plan_queries"], 4);
     }
+    // The depth stage on the sampled pairs, against the true depth: the distribution rises.
+    let stage = &report["depth_stage"];
+    assert!(stage["pixels"].as_u64().unwrap() > 1000, "{stage}");
+    let q = &stage["rel_error_quantiles"];
+    let at = |k: &str| q[k].as_f64().unwrap();
+    assert!(
+        at("p10") <= at("p25") && at("p25") <= at("p50") && at("p50") <= at("p75"),
+        "{q}"
+    );
+    assert!(at("p75") <= at("p90") && at("p50") < 0.2, "{q}");
+    assert!((at("p50") - stage["median_rel_error"].as_f64().unwrap()).abs() < 1e-3);
     for file in [
         "metrics.json",
         "report.md",

@@ -45,6 +45,44 @@ pub struct DepthStageSummary {
     pub median_rel_error_top50: f64,
     /// `interval_coverage` over the most confident half.
     pub interval_coverage_top50: f64,
+    /// The distribution of `|P0 - z| / z` over all compared pixels.
+    pub rel_error_quantiles: ErrorQuantiles,
+}
+
+/// Quantiles of a relative error, NaN when nothing was compared.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ErrorQuantiles {
+    /// 10th percentile.
+    pub p10: f64,
+    /// 25th percentile.
+    pub p25: f64,
+    /// The median.
+    pub p50: f64,
+    /// 75th percentile.
+    pub p75: f64,
+    /// 90th percentile.
+    pub p90: f64,
+}
+
+impl ErrorQuantiles {
+    /// The quantiles of `values` (nearest rank on the sorted values).
+    fn of(mut values: Vec<f32>) -> Self {
+        values.sort_by(f32::total_cmp);
+        let at = |q: f64| {
+            if values.is_empty() {
+                return f64::NAN;
+            }
+            let rank = (q * (values.len() - 1) as f64).round() as usize;
+            f64::from(values[rank])
+        };
+        Self {
+            p10: at(0.10),
+            p25: at(0.25),
+            p50: at(0.50),
+            p75: at(0.75),
+            p90: at(0.90),
+        }
+    }
 }
 
 /// One group of [`DepthStageErrors::by_confidence`].
@@ -160,6 +198,9 @@ impl DepthStageErrors {
             pixels_top50: top.len(),
             median_rel_error_top50: top_error,
             interval_coverage_top50: top_inside,
+            rel_error_quantiles: ErrorQuantiles::of(
+                self.compared.iter().map(|c| c.relative_error).collect(),
+            ),
         }
     }
 }
@@ -220,6 +261,16 @@ mod tests {
         assert!((s.median_rel_error_top50 - 0.1).abs() < 1e-6);
         assert_eq!(s.interval_coverage_top50, 1.0);
         assert_eq!(s.interval_coverage, 0.5);
+        // Half the pixels are 10% off, half 50%: the quantiles say so.
+        let q = s.rel_error_quantiles;
+        assert!(
+            (q.p10 - 0.1).abs() < 1e-6 && (q.p25 - 0.1).abs() < 1e-6,
+            "{q:?}"
+        );
+        assert!(
+            (q.p75 - 0.5).abs() < 1e-6 && (q.p90 - 0.5).abs() < 1e-6,
+            "{q:?}"
+        );
         // A sensor moved sideways still lands on the estimate's pixels (fewer of them).
         let mut moved = DepthStageErrors::default();
         moved.add(
@@ -232,5 +283,6 @@ mod tests {
         // Nothing compared.
         let empty = DepthStageErrors::default().summary();
         assert!(empty.median_rel_error.is_nan() && empty.interval_coverage.is_nan());
+        assert!(empty.rel_error_quantiles.p90.is_nan());
     }
 }

@@ -9,6 +9,7 @@ use nalgebra::Isometry3;
 
 use serde::Serialize;
 
+use super::depth_stage::{DepthStageErrors, DepthStageSummary};
 use super::flights::{
     Candidates, FlightOutcome, FlightQuery, FlightSummary, QueryConfig, draw_queries, plan_queries,
     summarize,
@@ -155,6 +156,10 @@ pub struct ExperimentReport {
     pub truth_flights: Option<FlightSummary>,
     /// Truly occupied voxels in the observed region.
     pub truth_occupied: usize,
+    /// The depth stage's accuracy on the sampled pairs ([`ExperimentConfig::sample_pairs`])
+    /// against the scene's true depth from the same camera; absent without samples.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_stage: Option<DepthStageSummary>,
     /// Seconds spent rendering, in the depth stage, and integrating.
     pub seconds: BTreeMap<String, f64>,
 }
@@ -449,6 +454,13 @@ pub fn run_experiment_with_progress(
         maps: maps_report,
         truth_flights: summary_of("truth"),
         truth_occupied: truth.occupied_count(),
+        depth_stage: (!samples.is_empty()).then(|| {
+            let mut errors = DepthStageErrors::default();
+            for sample in &samples {
+                errors.add_aligned(sample.frame.image(), &sample.truth.depth);
+            }
+            errors.summary()
+        }),
         seconds,
     };
     Ok(ExperimentOutput {

@@ -32,7 +32,7 @@ mod rgbd;
 mod truth;
 
 pub use charts::{depth_confidence_chart, maps_chart, operators_chart};
-pub use depth_stage::{ConfidenceBin, DepthStageErrors, DepthStageSummary};
+pub use depth_stage::{ConfidenceBin, DepthStageErrors, DepthStageSummary, ErrorQuantiles};
 pub use experiment::{
     DepthSample, ExperimentConfig, ExperimentOutput, ExperimentReport, MapReport, run_experiment,
     run_experiment_with_progress,
