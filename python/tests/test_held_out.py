@@ -82,6 +82,22 @@ def test_mono_flights_have_the_commands_keys_and_figures(tmp_path):
             assert ours[key] == theirs[key], key
 
 
+def test_mono_consistency_options_match_the_command(tmp_path):
+    folder = few_frames(tmp_path, 16, "rgbd-hololens-000")
+    report = fuzzyvox.mono(folder, **SETTINGS, consistency=2, min_agreeing=1)
+    command = command_json("mono", folder, "--consistency", "2", "--min-agreeing", "1")
+    assert report["consistency"] == command["consistency"]
+    check = report["consistency"]
+    assert (check["neighbours"], check["min_agreeing"]) == (2, 1)
+    assert 0 < check["pixels_kept"] <= check["pixels_checked"]
+    # Without the check every pixel of the depth stage reaches the maps.
+    unchecked = fuzzyvox.mono(folder, **SETTINGS, consistency=0)
+    assert unchecked["consistency"]["pixels_checked"] == 0
+    assert unchecked["depth_stage"]["pixels"] > report["depth_stage"]["pixels"]
+    with pytest.raises(fuzzyvox.InvalidInputError, match="min_agreeing"):
+        fuzzyvox.mono(folder, 0.1, consistency=2, min_agreeing=5)
+
+
 def test_held_out_runs_refuse_bad_settings(tmp_path):
     folder = few_frames(tmp_path, 10)
     with pytest.raises(fuzzyvox.InvalidInputError, match="holdout"):
