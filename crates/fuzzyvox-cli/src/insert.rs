@@ -11,24 +11,28 @@ use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
 ///
-/// Inputs: text clouds (`x y z [confidence]` per line; any extension but the two below),
-/// OctoMap scan graphs (`.graph`) and OctoMap text logs (`.log`, `NODE x y z roll pitch yaw`
-/// then points in the sensor frame). Each graph or log node is one scan from its own pose.
+/// Inputs: text clouds (`x y z [confidence]` per line; any extension but the three below),
+/// OctoMap scan graphs (`.graph`), OctoMap text logs (`.log`, `NODE x y z roll pitch yaw`
+/// then points in the sensor frame) and scan lists (`.list`, `CLOUD ox oy oz` per line: a text
+/// cloud in world coordinates, relative to the list's folder, and its sensor origin). Each
+/// graph or log node and each list line is one scan from its own origin.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
     fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
     fuzzyvox insert --cloud scan.dat --res 0.05 --model logodds --json\n  \
     fuzzyvox insert --cloud cloud.xyz --res 0.05 --origin 0,0,1.2 --max-range 20 --op dombi:2 --json\n  \
     fuzzyvox insert --cloud confident.xyz --res 0.1 --model alpha --cuts 10 --out alpha.fvx\n  \
-    fuzzyvox insert --cloud new.xyz --res 0.08 --prior geb079.bt --prior-confidence 0.6 --out updated.fvx")]
+    fuzzyvox insert --cloud new.xyz --res 0.08 --prior geb079.bt --prior-confidence 0.6 --out updated.fvx\n  \
+    fuzzyvox insert --cloud scans.list --res 0.05 --model logodds --json")]
 pub struct InsertArgs {
-    /// Input scans: a text cloud, an OctoMap `.graph` or an OctoMap `.log`.
+    /// Input scans: a text cloud, an OctoMap `.graph`, an OctoMap `.log` or a scan list
+    /// (`.list`).
     #[arg(long)]
     cloud: PathBuf,
     /// Voxel size in metres.
     #[arg(long, allow_negative_numbers = true)]
     res: f64,
-    /// Sensor origin of a text cloud as X,Y,Z (metres).
+    /// Sensor origin of a text cloud as X,Y,Z (metres); scan lists give their own.
     #[arg(long, value_parser = super::parse_point, default_value = "0,0,0", allow_hyphen_values = true)]
     origin: nalgebra::Point3<f64>,
     /// Cut rays longer than this (metres); the cut part clears free space only.

@@ -330,3 +330,68 @@ fn every_command_has_help_with_examples() {
         assert!(text.contains("--verbose"), "{command} takes -v");
     }
 }
+
+#[test]
+fn insert_reads_a_scan_list_each_scan_from_its_own_origin() {
+    let dir = scratch("scan-list");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let (mut a, mut b) = (String::new(), String::new());
+    for i in 0..=20 {
+        for j in 0..=10 {
+            let (s, z) = (-1.0 + 0.1 * f64::from(i), 0.1 * f64::from(j));
+            a.push_str(&format!("3.0 {s} {z} 0.9\n"));
+            b.push_str(&format!("{s} 3.0 {z} 0.8\n"));
+        }
+    }
+    std::fs::write(dir.join("a.xyz"), &a).unwrap();
+    std::fs::write(dir.join("sub").join("b.xyz"), &b).unwrap();
+    let list = dir.join("scans.list");
+    std::fs::write(
+        &list,
+        "# wall ahead, wall to the left\na.xyz 0 0 0.5\nsub/b.xyz 0.4 -0.2 0.5\n",
+    )
+    .unwrap();
+    let list = list.to_str().unwrap();
+    for model in ["logodds", "alpha", "fuzzy"] {
+        let report = json(&fuzzyvox(&[
+            "insert", "--cloud", list, "--res", "0.1", "--model", model, "--json",
+        ]));
+        assert_eq!(report["scans"], 2, "{model}");
+        assert_eq!(report["points"], 2 * 21 * 11, "{model}");
+        // The same clouds from the same origins, one after the other, through the library.
+        let kind: fuzzyvox::MapKind = model.parse().unwrap();
+        let mut map = kind.new_map(0.1).unwrap();
+        for (file, origin) in [
+            ("a.xyz", nalgebra::Point3::new(0.0, 0.0, 0.5)),
+            ("sub/b.xyz", nalgebra::Point3::new(0.4, -0.2, 0.5)),
+        ] {
+            let cloud = fuzzyvox::io::read_text_cloud(&dir.join(file), origin).unwrap();
+            map.as_map_mut()
+                .integrate_cloud(&cloud, &Default::default())
+                .unwrap();
+        }
+        let counts = map.as_map().counts();
+        assert_eq!(report["occupied"], counts.occupied, "{model}");
+        assert_eq!(report["free"], counts.free, "{model}");
+        assert!(counts.occupied > 0 && counts.free > 0, "{model}");
+    }
+    // A bad line is an error naming it, and nothing is written.
+    let bad = dir.join("bad.list");
+    std::fs::write(&bad, "a.xyz 0 0 0.5\nsub/b.xyz 0 0\n").unwrap();
+    let out = dir.join("out.fvx");
+    fails(
+        &[
+            "insert",
+            "--cloud",
+            bad.to_str().unwrap(),
+            "--res",
+            "0.1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        1,
+        "bad.list:2: expected `CLOUD ox oy oz`, found 3 fields",
+    );
+    assert!(!out.exists(), "a failed insert wrote a map");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

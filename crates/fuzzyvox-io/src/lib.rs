@@ -20,9 +20,11 @@ pub mod ply;
 pub mod posed;
 pub mod rgbd;
 pub mod rgbd_write;
+mod scan_list;
 
 pub use cloud_text::{parse_text_cloud, read_text_cloud};
 pub use fuzzyvox_core::file::{MapHeader, read_header, write_atomic};
 pub use fuzzyvox_core::map::MapKind;
 pub use gray::{decode_gray_image, read_gray_image};
 pub use load::{LoadedMap, MapFormat, load_map};
+pub use scan_list::{ScanListEntry, read_scan_list, read_scan_list_entries};
