@@ -2,6 +2,20 @@ use nalgebra::Point3;
 
 use crate::storage::{Resolution, VoxelKey};
 
+use crate::storage::BlockKey;
+
+/// Where a ray walk reports the voxels it visits, block by block: [`CellSink::enter`] when the
+/// walk enters a block (and before its first voxel), [`CellSink::mark`] for each voxel with its
+/// index in the block (see [`VoxelKey::cell_index`]). Consecutive voxels of a ray mostly share a
+/// block, so a sink that looks a block up once per `enter` does one lookup per block crossed
+/// rather than one per voxel.
+pub trait CellSink {
+    /// The walk enters block `block`.
+    fn enter(&mut self, block: BlockKey);
+    /// The walk visits cell `cell` of the block last entered.
+    fn mark(&mut self, cell: usize);
+}
+
 /// Visits the voxels that OctoMap 1.9's `computeRayKeys` reports as free for a ray from
 /// `origin` to `end`, in order: the origin's voxel, then every voxel crossed before the end
 /// voxel. Returns `false` when either end has no key (OctoMap skips such rays).
@@ -15,7 +29,40 @@ pub fn walk_ray_octomap(
     resolution: &Resolution,
     origin: [f32; 3],
     end: [f32; 3],
-    mut visit: impl FnMut(VoxelKey),
+    visit: impl FnMut(VoxelKey),
+) -> bool {
+    struct Keys<F> {
+        block: BlockKey,
+        visit: F,
+    }
+    impl<F: FnMut(VoxelKey)> CellSink for Keys<F> {
+        fn enter(&mut self, block: BlockKey) {
+            self.block = block;
+        }
+        fn mark(&mut self, cell: usize) {
+            (self.visit)(self.block.voxel(cell));
+        }
+    }
+    walk_ray_octomap_cells(
+        resolution,
+        origin,
+        end,
+        &mut Keys {
+            block: BlockKey::new(0, 0, 0),
+            visit,
+        },
+    )
+}
+
+/// [`walk_ray_octomap`] reporting its voxels block by block to `sink`: the same voxels in the
+/// same order. A step that stays in its block moves the cell index by ±1, ±8 or ±64 instead of
+/// recomputing the block, which is most of what marking a voxel costs.
+#[inline]
+pub fn walk_ray_octomap_cells(
+    resolution: &Resolution,
+    origin: [f32; 3],
+    end: [f32; 3],
+    sink: &mut impl CellSink,
 ) -> bool {
     let key_of = |p: [f32; 3]| {
         resolution.try_key_of(&Point3::new(
@@ -30,7 +77,9 @@ pub fn walk_ray_octomap(
     if start == stop {
         return true;
     }
-    visit(start);
+    sink.enter(start.block());
+    let mut cell = start.cell_index();
+    sink.mark(cell);
 
     // Direction and length in single precision, as OctoMap's Vector3 computes them.
     let mut direction = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
@@ -57,36 +106,55 @@ pub fn walk_ray_octomap(
     let (step_y, mut t_y, delta_y) = axis(start.y, origin[1], direction[1]);
     let (step_z, mut t_z, delta_z) = axis(start.z, origin[2], direction[2]);
     let (mut x, mut y, mut z) = (start.x, start.y, start.z);
+    // The low three bits a coordinate has just after it stepped into a new block.
+    let entry = |step: i32| if step > 0 { 0 } else { 7 };
+    let (entry_x, entry_y, entry_z) = (entry(step_x), entry(step_y), entry(step_z));
     let length = f64::from(length);
+    // Steps until the walk can first stand on the end key: every step moves one coordinate
+    // towards it or past it, and a coordinate that passed it never comes back.
+    let mut until_end = (i64::from(stop.x) - i64::from(x)).unsigned_abs()
+        + (i64::from(stop.y) - i64::from(y)).unsigned_abs()
+        + (i64::from(stop.z) - i64::from(z)).unsigned_abs();
     // OctoMap stops by its own rules; the cap only guards against a walk that would never end
     // and lies far above any real ray's step count.
-    let cap = (i64::from(stop.x) - i64::from(x)).unsigned_abs()
-        + (i64::from(stop.y) - i64::from(y)).unsigned_abs()
-        + (i64::from(stop.z) - i64::from(z)).unsigned_abs()
-        + 64;
+    let cap = until_end + 64;
+    // One step along an axis, then OctoMap's two stop rules, then the visit. Only the axis
+    // that stepped changed, so its parameter is tested first against the length (OctoMap's
+    // `min(min(tx, ty), tz) > length`; no parameter is NaN) and the end key is compared only
+    // once enough steps were taken.
+    macro_rules! step {
+        ($c:ident, $t:ident, $step:expr, $delta:expr, $entry:expr, $moved:expr) => {{
+            $c += $step;
+            $t += $delta;
+            until_end = until_end.wrapping_sub(1);
+            if until_end == 0 && x == stop.x && y == stop.y && z == stop.z {
+                break;
+            }
+            if $t > length && t_x > length && t_y > length && t_z > length {
+                break;
+            }
+            if $c & 7 == $entry {
+                let key = VoxelKey::new(x, y, z);
+                sink.enter(key.block());
+                cell = key.cell_index();
+            } else {
+                cell = cell.wrapping_add_signed($moved);
+            }
+            sink.mark(cell);
+        }};
+    }
     for _ in 0..cap {
         if t_x < t_y {
             if t_x < t_z {
-                x += step_x;
-                t_x += delta_x;
+                step!(x, t_x, step_x, delta_x, entry_x, step_x as isize);
             } else {
-                z += step_z;
-                t_z += delta_z;
+                step!(z, t_z, step_z, delta_z, entry_z, 64 * step_z as isize);
             }
         } else if t_y < t_z {
-            y += step_y;
-            t_y += delta_y;
+            step!(y, t_y, step_y, delta_y, entry_y, 8 * step_y as isize);
         } else {
-            z += step_z;
-            t_z += delta_z;
+            step!(z, t_z, step_z, delta_z, entry_z, 64 * step_z as isize);
         }
-        if x == stop.x && y == stop.y && z == stop.z {
-            break;
-        }
-        if t_x.min(t_y).min(t_z) > length {
-            break;
-        }
-        visit(VoxelKey::new(x, y, z));
     }
     true
 }

@@ -145,10 +145,17 @@ struct CellUpdates {
 impl CellUpdates {
     /// Gives cell `i` of `block` `hits` hit updates, then misses up to `total` updates, each an
     /// add then a clamp in single precision as OctoMap's `updateNodeLogOdds` does, and keeps the
-    /// block's class counts current without reclassifying every cell.
+    /// block's class counts current without reclassifying every cell. Returns whether the cell
+    /// changed.
     #[inline(always)]
-    /// Returns whether the cell changed.
-    fn apply(self, block: &mut Block<LogOdds>, i: usize, hits: u16, total: u16) -> bool {
+    fn apply(
+        self,
+        block: &mut Block<LogOdds>,
+        classes: &mut ClassMemo,
+        i: usize,
+        hits: u16,
+        total: u16,
+    ) -> bool {
         let Some(cell) = block.cells.get_mut(i) else {
             return false;
         };
@@ -159,11 +166,44 @@ impl CellUpdates {
             current = (current + update).clamp(self.min, self.max);
         }
         cell.0 = current;
-        let classify = |c: LogOdds| self.measures.classify(c.memberships());
-        block
-            .summary
-            .moved(classify(before), classify(LogOdds(current)));
+        let from = classes.class(before, &self.measures);
+        let to = classes.class(LogOdds(current), &self.measures);
+        block.summary.moved(from, to);
         before.0.to_bits() != current.to_bits()
+    }
+}
+
+/// The classes of the last few log-odds values classified: a scan gives most voxels of a block
+/// one of a handful of values, so classification (an `exp` and the measures) runs once per
+/// value rather than twice per update.
+struct ClassMemo {
+    entries: [(u32, VoxelClass); 8],
+}
+
+impl ClassMemo {
+    fn new() -> Self {
+        // NaN bits never come from an update, and unobserved cells are handled before the
+        // table, so this placeholder never matches a real lookup with a wrong class.
+        Self {
+            entries: [(f32::NAN.to_bits() ^ 1, VoxelClass::Unknown); 8],
+        }
+    }
+
+    #[inline]
+    fn class(&mut self, value: LogOdds, measures: &MeasureConfig) -> VoxelClass {
+        if !value.is_observed() {
+            return VoxelClass::Unknown;
+        }
+        let bits = value.0.to_bits();
+        let slot = ((bits ^ (bits >> 11) ^ (bits >> 19)) & 7) as usize;
+        match self.entries[slot] {
+            (cached, class) if cached == bits => class,
+            _ => {
+                let class = measures.classify(value.memberships());
+                self.entries[slot] = (bits, class);
+                class
+            }
+        }
     }
 }
 
@@ -222,13 +262,15 @@ impl LogOddsMap {
         self.grid
             .update_blocks(sets.blocks().collect(), |block, flags| {
                 let (mut updated, mut changed) = (0, false);
+                let mut classes = ClassMemo::new();
                 for word in 0..flags.passed.len() {
                     let mut marked = flags.passed[word] | flags.hit[word];
                     while marked != 0 {
                         let bit = marked.trailing_zeros() as usize;
                         marked &= marked - 1;
                         let hit = flags.hit[word] & (1 << bit) != 0;
-                        changed |= updates.apply(block, word * 64 + bit, u16::from(hit), 1);
+                        changed |=
+                            updates.apply(block, &mut classes, word * 64 + bit, u16::from(hit), 1);
                         updated += 1;
                     }
                 }
@@ -247,10 +289,11 @@ impl LogOddsMap {
         self.grid
             .update_blocks(levels.blocks().collect(), |block, marks| {
                 let (mut updated, mut changed) = (0, false);
+                let mut classes = ClassMemo::new();
                 for (i, (&passed, &hit)) in marks.passed.iter().zip(&marks.hit).enumerate() {
                     let cuts = passed.max(hit);
                     if cuts > 0 {
-                        changed |= updates.apply(block, i, hit, cuts);
+                        changed |= updates.apply(block, &mut classes, i, hit, cuts);
                         updated += usize::from(cuts);
                     }
                 }
