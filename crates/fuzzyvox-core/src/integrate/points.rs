@@ -6,13 +6,17 @@ use super::evidence::{
     EvidenceModel, IntegrationOptions, IntegrationStats, ScanEvidence, check_ray_length, merge_max,
     raise,
 };
-use super::raywalk::walk_ray;
+use super::octomap_walk::CellSink;
+use super::raywalk::walk_ray_cells;
 use crate::error::{Error, Result};
 use crate::ops::TConorm;
-use crate::storage::{AccessorMut, Resolution, VoxelKey};
+use crate::storage::{AccessorMut, BlockKey, Resolution, VoxelKey};
 
-/// Points per unit of parallel work.
+/// Fewest points per unit of parallel work.
 const CHUNK: usize = 1024;
+
+/// Pieces of a cloud per thread.
+const PIECES_PER_THREAD: usize = 2;
 
 /// Turns a point cloud into one scan's evidence.
 ///
@@ -54,34 +58,36 @@ pub fn cloud_evidence(
         }
         check_ray_length(ray.range, resolution.size())?;
     }
-    // `fold` keeps one partial scan per piece of work that rayon schedules (a few per thread,
-    // balanced by work stealing); `max` combines them exactly, so neither the split nor the
-    // thread count changes the result.
+    // Each piece of the cloud (a few per thread, so that rays of different lengths balance)
+    // deposits into its own partial scan; `max` combines them exactly, so neither the split
+    // nor the thread count changes the result. Few pieces keep the partial scans, and the
+    // blocks they must merge, few.
+    let pieces = (rayon::current_num_threads() * PIECES_PER_THREAD).max(1);
+    let piece = cloud.points().len().div_ceil(pieces).max(CHUNK);
     let (evidence, stats) = cloud
         .points()
-        .par_chunks(CHUNK)
+        .par_chunks(piece)
         .enumerate()
-        .fold(
-            || (ScanEvidence::new(), IntegrationStats::default()),
-            |(mut scan, mut stats), (chunk_index, chunk)| {
-                let mut acc = AccessorMut::new(&mut scan);
-                for (offset, point) in chunk.iter().enumerate() {
-                    let Some(ray) = ray_of(point) else {
-                        stats.skipped += 1;
-                        continue;
-                    };
-                    stats.integrated += 1;
-                    stats.clipped += usize::from(ray.clipped);
-                    let index = chunk_index * CHUNK + offset;
-                    let weight = PointWeight {
-                        confidence: cloud.confidence_of(index),
-                        reliability: cloud.reliability_of(index),
-                    };
-                    ray.deposit(&mut acc, resolution, origin_key, model, operator, weight);
-                }
-                (scan, stats)
-            },
-        )
+        .map(|(piece_index, chunk)| {
+            let mut scan = ScanEvidence::new();
+            let mut stats = IntegrationStats::default();
+            let mut acc = AccessorMut::new(&mut scan);
+            for (offset, point) in chunk.iter().enumerate() {
+                let Some(ray) = ray_of(point) else {
+                    stats.skipped += 1;
+                    continue;
+                };
+                stats.integrated += 1;
+                stats.clipped += usize::from(ray.clipped);
+                let index = piece_index * piece + offset;
+                let weight = PointWeight {
+                    confidence: cloud.confidence_of(index),
+                    reliability: cloud.reliability_of(index),
+                };
+                ray.deposit(&mut acc, resolution, origin_key, model, operator, weight);
+            }
+            (scan, stats)
+        })
         .reduce(
             || (ScanEvidence::new(), IntegrationStats::default()),
             |(a, sa), (b, sb)| {
@@ -95,6 +101,47 @@ pub fn cloud_evidence(
             },
         );
     Ok((evidence, stats))
+}
+
+/// Free evidence along one ray, taken block by block from its walk: every voxel before the end
+/// voxel is raised to the ray's free evidence, except voxels inside the ray's own occupied
+/// kernel.
+struct FreeAlongRay<'a, 'g> {
+    acc: &'a mut AccessorMut<'g, super::Evidence>,
+    /// The block the walk is in.
+    block: BlockKey,
+    /// Key steps from the voxel about to be visited to the end voxel (the walk takes exactly
+    /// as many steps as the keys differ).
+    steps_to_end: i32,
+    /// Voxels at most this many key steps from the end are checked against the kernel.
+    near_end: i32,
+    reach: f64,
+    end: Point3<f64>,
+    resolution: &'a Resolution,
+    free: f32,
+}
+
+impl CellSink for FreeAlongRay<'_, '_> {
+    #[inline(always)]
+    fn enter(&mut self, block: BlockKey) {
+        self.block = block;
+    }
+
+    #[inline(always)]
+    fn mark(&mut self, cell: usize) {
+        let close = self.steps_to_end <= self.near_end;
+        self.steps_to_end -= 1;
+        if close {
+            let key = self.block.voxel(cell);
+            if (self.resolution.center(key) - self.end).norm() <= self.reach {
+                return;
+            }
+        }
+        // Occupied evidence is never negative, so raising it to 0 (as `raise` would) changes
+        // nothing.
+        let evidence = self.acc.cell_of_block(self.block, cell);
+        evidence.free = evidence.free.max(self.free);
+    }
 }
 
 /// A point's confidence (its end point's occupied evidence) and reliability (its ray's free
@@ -168,26 +215,29 @@ impl Ray {
         };
         // The walk takes exactly as many steps as the keys differ, so a countdown tells how far
         // (in key steps) each visited voxel is from the end voxel.
-        let mut steps_to_end = (origin_key.x - end_key.x).abs()
+        let steps_to_end = (origin_key.x - end_key.x).abs()
             + (origin_key.y - end_key.y).abs()
             + (origin_key.z - end_key.z).abs();
         // A ray of no free weight (dual model, reliability 0) still marks its end point.
         let kernel_only = free <= 0.0;
         if !kernel_only {
-            walk_ray(
+            let mut sink = FreeAlongRay {
+                acc,
+                block: origin_key.block(),
+                steps_to_end,
+                near_end,
+                reach,
+                end: self.end,
+                resolution,
+                free,
+            };
+            walk_ray_cells(
                 resolution,
                 &self.origin,
                 &self.end,
                 origin_key,
                 end_key,
-                |key| {
-                    let close = steps_to_end <= near_end;
-                    steps_to_end -= 1;
-                    if close && (resolution.center(key) - self.end).norm() <= reach {
-                        return;
-                    }
-                    raise(acc, key, 0.0, free);
-                },
+                &mut sink,
             );
         }
         if self.clipped || confidence <= 0.0 {

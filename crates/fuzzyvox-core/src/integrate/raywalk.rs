@@ -86,6 +86,86 @@ pub fn walk_ray_until<B>(
     ControlFlow::Continue(())
 }
 
+/// [`walk_ray`] reporting its voxels block by block to `sink` (see
+/// [`CellSink`](super::octomap_walk::CellSink)): the same voxels in the same order, with a step
+/// that stays in its block moving the cell index instead of recomputing the block.
+#[inline]
+pub fn walk_ray_cells(
+    resolution: &Resolution,
+    from: &Point3<f64>,
+    to: &Point3<f64>,
+    start: VoxelKey,
+    end: VoxelKey,
+    sink: &mut impl super::octomap_walk::CellSink,
+) {
+    let direction = to - from;
+    let size = resolution.size();
+    let axis = |current: i32, target: i32, from: f64, d: f64| -> (i32, f64, f64) {
+        if current == target || d == 0.0 {
+            (0, f64::INFINITY, f64::INFINITY)
+        } else {
+            let step = if d > 0.0 { 1 } else { -1 };
+            let border = f64::from(current + i32::from(d > 0.0)) * size;
+            (step, (border - from) / d, size / d.abs())
+        }
+    };
+    let (step_x, mut t_x, delta_x) = axis(start.x, end.x, from.x, direction.x);
+    let (step_y, mut t_y, delta_y) = axis(start.y, end.y, from.y, direction.y);
+    let (step_z, mut t_z, delta_z) = axis(start.z, end.z, from.z, direction.z);
+    let (mut x, mut y, mut z) = (start.x, start.y, start.z);
+    let mut remaining = (i64::from(end.x) - i64::from(x)).unsigned_abs()
+        + (i64::from(end.y) - i64::from(y)).unsigned_abs()
+        + (i64::from(end.z) - i64::from(z)).unsigned_abs();
+    if remaining == 0 {
+        return;
+    }
+    // The low three bits a coordinate has just after it stepped into a new block.
+    let entry = |step: i32| if step > 0 { 0 } else { 7 };
+    let (entry_x, entry_y, entry_z) = (entry(step_x), entry(step_y), entry(step_z));
+    sink.enter(start.block());
+    let mut cell = start.cell_index();
+    loop {
+        sink.mark(cell);
+        remaining -= 1;
+        if remaining == 0 {
+            return;
+        }
+        let crossed = if t_x <= t_y && t_x <= t_z {
+            x += step_x;
+            t_x = if x == end.x {
+                f64::INFINITY
+            } else {
+                t_x + delta_x
+            };
+            cell = cell.wrapping_add_signed(step_x as isize);
+            x & 7 == entry_x
+        } else if t_y <= t_z {
+            y += step_y;
+            t_y = if y == end.y {
+                f64::INFINITY
+            } else {
+                t_y + delta_y
+            };
+            cell = cell.wrapping_add_signed(8 * step_y as isize);
+            y & 7 == entry_y
+        } else {
+            z += step_z;
+            t_z = if z == end.z {
+                f64::INFINITY
+            } else {
+                t_z + delta_z
+            };
+            cell = cell.wrapping_add_signed(64 * step_z as isize);
+            z & 7 == entry_z
+        };
+        if crossed {
+            let key = VoxelKey::new(x, y, z);
+            sink.enter(key.block());
+            cell = key.cell_index();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,6 +226,35 @@ mod tests {
             let c = r.center(*k) - a;
             let dist = (c - dir * c.dot(&dir)).norm();
             assert!(dist <= 0.0867, "{k:?} is {dist} m from the ray");
+        }
+    }
+
+    #[test]
+    fn the_blockwise_walk_visits_the_same_voxels() {
+        struct Keys(crate::storage::BlockKey, Vec<VoxelKey>);
+        impl super::super::octomap_walk::CellSink for Keys {
+            fn enter(&mut self, block: crate::storage::BlockKey) {
+                self.0 = block;
+            }
+            fn mark(&mut self, cell: usize) {
+                self.1.push(self.0.voxel(cell));
+            }
+        }
+        let r = Resolution::new(0.05).unwrap();
+        for i in 0..400 {
+            let a = f64::from(i) * 0.61;
+            let from = Point3::new(0.013 * a.sin() - 0.4, 0.021 * a.cos(), -0.017 * a);
+            let to = Point3::new(
+                4.0 * a.cos() + 0.0123,
+                -3.0 * (0.7 * a).sin() - 0.0171,
+                2.5 * (0.3 * a).sin() + 0.0137,
+            );
+            let (start, end) = (r.key_of(&from).unwrap(), r.key_of(&to).unwrap());
+            let mut expected = Vec::new();
+            walk_ray(&r, &from, &to, start, end, |k| expected.push(k));
+            let mut blockwise = Keys(crate::storage::BlockKey::new(0, 0, 0), Vec::new());
+            walk_ray_cells(&r, &from, &to, start, end, &mut blockwise);
+            assert_eq!(blockwise.1, expected, "ray {i}");
         }
     }
 }

@@ -32,6 +32,10 @@ impl<'a, C: Copy + Default> Accessor<'a, C> {
 }
 
 /// Writes cells through a cache of the last block visited, allocating blocks on demand.
+///
+/// The accessor is one write to the grid: it advances the grid's version when it is made and
+/// records each block it writes when it enters it, so a write inside the cached block costs
+/// no more than the store.
 pub struct AccessorMut<'a, C> {
     grid: &'a mut BlockGrid<C>,
     last: Option<(BlockKey, usize)>,
@@ -40,22 +44,31 @@ pub struct AccessorMut<'a, C> {
 impl<'a, C: Copy + Default> AccessorMut<'a, C> {
     /// A writing accessor over `grid`.
     pub fn new(grid: &'a mut BlockGrid<C>) -> Self {
+        grid.begin_write();
         Self { grid, last: None }
     }
 
     /// The cell at `key`, allocating its block when needed.
     #[inline]
     pub fn get_or_insert(&mut self, key: VoxelKey) -> &mut C {
-        let block_key = key.block();
+        self.cell_of_block(key.block(), key.cell_index())
+    }
+
+    /// Cell `cell` (an index as [`VoxelKey::cell_index`] gives it) of block `block`, allocating
+    /// the block when needed: for a writer that already knows the block, such as a ray walk
+    /// reporting its voxels block by block.
+    #[inline]
+    pub fn cell_of_block(&mut self, block: BlockKey, cell: usize) -> &mut C {
         let position = match self.last {
-            Some((cached, position)) if cached == block_key => position,
+            Some((cached, position)) if cached == block => position,
             _ => {
-                let position = self.grid.ensure_block(block_key);
-                self.last = Some((block_key, position));
+                let position = self.grid.ensure_block(block);
+                self.grid.mark(position);
+                self.last = Some((block, position));
                 position
             }
         };
-        &mut self.grid.block_at_mut(position).cells[key.cell_index()]
+        self.grid.cell_at_mut_unrecorded(position, cell)
     }
 }
 

@@ -59,13 +59,13 @@ impl<C: Copy + Default> BlockGrid<C> {
     }
 
     /// Starts a write: advances the version and returns it.
-    fn begin_write(&mut self) -> u64 {
+    pub(super) fn begin_write(&mut self) -> u64 {
         self.version += 1;
         self.version
     }
 
     /// Records a write to the block at `position` in the current version.
-    fn mark(&mut self, position: usize) {
+    pub(super) fn mark(&mut self, position: usize) {
         self.written[position] = self.version;
     }
 
@@ -150,6 +150,14 @@ impl<C: Copy + Default> BlockGrid<C> {
         self.begin_write();
         self.mark(position);
         &mut self.blocks[position]
+    }
+
+    /// Cell `cell` of the block at a storage position, for writing, without recording the
+    /// write: for a writer that has already recorded it ([`super::AccessorMut`] records each
+    /// block once when it enters it).
+    #[inline]
+    pub(super) fn cell_at_mut_unrecorded(&mut self, position: usize, cell: usize) -> &mut C {
+        &mut self.blocks[position].cells[cell]
     }
 
     /// The cell at `key`, if its block is allocated.
