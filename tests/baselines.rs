@@ -131,6 +131,70 @@ fn saved_bytes_do_not_depend_on_the_thread_count_for_any_map() {
 }
 
 #[test]
+fn a_list_of_scans_gives_every_map_what_one_scan_at_a_time_gives_and_fails_whole() {
+    // Scans of different sizes, from different origins, some of them sharing voxels.
+    let scans: Vec<_> = (0..11u32)
+        .map(|i| {
+            let origin = Point3::new(0.25 * f64::from(i % 4), -0.2 * f64::from(i % 3), 0.1);
+            room_scan(origin, 300 + 700 * (i as usize % 3), u64::from(i))
+        })
+        .collect();
+    let options = IntegrationOptions::default();
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            for (mut one_by_one, mut batched) in maps(0.1).into_iter().zip(maps(0.1)) {
+                let kind = one_by_one.kind().name();
+                let mut expected = Vec::new();
+                for scan in &scans {
+                    expected.push(
+                        one_by_one
+                            .as_map_mut()
+                            .integrate_cloud(scan, &options)
+                            .unwrap(),
+                    );
+                }
+                let stats = batched
+                    .as_map_mut()
+                    .integrate_clouds(&scans, &options)
+                    .unwrap();
+                assert_eq!(stats, expected, "{kind}, {threads} threads");
+                assert_eq!(
+                    batched.to_bytes(),
+                    one_by_one.to_bytes(),
+                    "{kind}, {threads} threads"
+                );
+                // A bad scan anywhere in the list: an error, and the map as it was.
+                let mut bad = scans.clone();
+                bad.insert(
+                    7,
+                    fuzzyvox::PointCloud::new(Point3::origin(), vec![Point3::new(1e12, 0.0, 0.0)])
+                        .unwrap(),
+                );
+                assert!(
+                    batched
+                        .as_map_mut()
+                        .integrate_clouds(&bad, &options)
+                        .is_err(),
+                    "{kind}"
+                );
+                assert_eq!(batched.to_bytes(), one_by_one.to_bytes(), "{kind}");
+                assert!(
+                    batched
+                        .as_map_mut()
+                        .integrate_clouds(&[], &options)
+                        .unwrap()
+                        .is_empty()
+                );
+            }
+        });
+    }
+}
+
+#[test]
 fn baseline_maps_round_trip_through_files_and_reject_the_wrong_kind() {
     let dir = std::env::temp_dir().join(format!("fuzzyvox-baselines-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -7,6 +7,9 @@ use fuzzyvox::map::{MapKind, MapOptions};
 use fuzzyvox::{Family, IntegrationOptions, IntegrationStats};
 
 use super::maps::{Evidence, PriorArgs, kind_parser};
+
+/// Scans handed to the map at once by `insert`.
+const SCANS_PER_BATCH: usize = 16;
 use serde_json::json;
 
 /// Integrate point clouds into a new map and report what it holds.
@@ -98,21 +101,30 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let mut total = IntegrationStats::default();
     let bar = super::progress::bar(scans.len() as u64, "integrating", args.json);
-    for (index, scan) in scans.iter().enumerate() {
-        let stats = map
+    // Scans go to the map a batch at a time (it walks a batch's scans side by side), small
+    // enough batches for the progress bar to move.
+    for (batch, chunk) in scans.chunks(SCANS_PER_BATCH).enumerate() {
+        let first = batch * SCANS_PER_BATCH;
+        let all = map
             .as_map_mut()
-            .integrate_cloud(scan, &options)
-            .with_context(|| format!("integrating scan {index}"))?;
-        total.integrated += stats.integrated;
-        total.skipped += stats.skipped;
-        total.clipped += stats.clipped;
-        total.voxels_updated += stats.voxels_updated;
-        tracing::debug!(
-            "scan {index}: {} points, {} voxels updated",
-            stats.integrated,
-            stats.voxels_updated
-        );
-        bar.inc(1);
+            .integrate_clouds(chunk, &options)
+            .with_context(|| match chunk.len() {
+                1 => format!("integrating scan {first}"),
+                n => format!("integrating scans {first} to {}", first + n - 1),
+            })?;
+        for (offset, stats) in all.iter().enumerate() {
+            total.integrated += stats.integrated;
+            total.skipped += stats.skipped;
+            total.clipped += stats.clipped;
+            total.voxels_updated += stats.voxels_updated;
+            tracing::debug!(
+                "scan {}: {} points, {} voxels updated",
+                first + offset,
+                stats.integrated,
+                stats.voxels_updated
+            );
+        }
+        bar.inc(chunk.len() as u64);
     }
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();

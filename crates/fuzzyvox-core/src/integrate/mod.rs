@@ -10,6 +10,7 @@
 //! `max`, which is exact in floating point; the evidence, and hence the map, is the same bit for
 //! bit for any number of threads.
 
+mod batches;
 mod cloud;
 mod depth_image;
 mod evidence;
@@ -20,6 +21,7 @@ mod points;
 mod raywalk;
 mod scan_sets;
 
+pub(crate) use batches::scan_groups;
 pub use cloud::PointCloud;
 pub use depth_image::{DepthFrame, IntervalDepthImage};
 pub use evidence::{
@@ -28,7 +30,9 @@ pub use evidence::{
 pub use frustum::depth_evidence;
 pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;
+pub(crate) use points::{check_cloud, cloud_evidence_checked};
 pub use raywalk::{walk_ray, walk_ray_until};
 pub use scan_sets::{
     BlockFlags, BlockLevels, CellMarks, ScanBlocks, ScanLevels, ScanSets, scan_levels, scan_sets,
 };
+pub(crate) use scan_sets::{Checked, check_octomap_scan, walk_scan};

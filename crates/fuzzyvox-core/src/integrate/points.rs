@@ -8,6 +8,7 @@ use super::evidence::{
 };
 use super::octomap_walk::CellSink;
 use super::raywalk::walk_ray_cells;
+use super::scan_sets::Checked;
 use crate::error::{Error, Result};
 use crate::ops::TConorm;
 use crate::storage::{AccessorMut, BlockKey, Resolution, VoxelKey};
@@ -34,13 +35,21 @@ pub fn cloud_evidence(
     operator: &TConorm,
     options: &IntegrationOptions,
 ) -> Result<(ScanEvidence, IntegrationStats)> {
+    cloud_evidence_checked(cloud, resolution, model, operator, options, Checked::No)
+}
+
+/// Checks everything that [`cloud_evidence`] rejects, before any work: the options, the
+/// origin's key, every ray's end key and length (cut at `max_range`).
+pub(crate) fn check_cloud(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    options: &IntegrationOptions,
+) -> Result<()> {
     let options = options.validate()?;
     let origin = cloud.origin();
-    let origin_key = resolution.key_of(&origin)?;
+    resolution.key_of(&origin)?;
     let ray_of = |p: &Point3<f64>| Ray::new(&origin, p, options.max_range);
-    // Validate every end key and ray length first, so that a bad point fails the call before
-    // any work. Rays are made on the fly, here and below, so memory does not grow with the
-    // cloud.
+    // Rays are made on the fly, here and in the walk, so memory does not grow with the cloud.
     let too_long = |ray: &Ray| check_ray_length(ray.range, resolution.size()).is_err();
     if let Some(ray) = cloud
         .points()
@@ -58,6 +67,25 @@ pub fn cloud_evidence(
         }
         check_ray_length(ray.range, resolution.size())?;
     }
+    Ok(())
+}
+
+/// [`cloud_evidence`], skipping the checks when the caller made them ([`check_cloud`]).
+pub(crate) fn cloud_evidence_checked(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    model: &EvidenceModel,
+    operator: &TConorm,
+    options: &IntegrationOptions,
+    checked: Checked,
+) -> Result<(ScanEvidence, IntegrationStats)> {
+    if checked == Checked::No {
+        check_cloud(cloud, resolution, options)?;
+    }
+    let options = options.validate()?;
+    let origin = cloud.origin();
+    let origin_key = resolution.key_of(&origin)?;
+    let ray_of = |p: &Point3<f64>| Ray::new(&origin, p, options.max_range);
     // Each piece of the cloud (a few per thread, so that rays of different lengths balance)
     // deposits into its own partial scan; `max` combines them exactly, so neither the split
     // nor the thread count changes the result. Few pieces keep the partial scans, and the

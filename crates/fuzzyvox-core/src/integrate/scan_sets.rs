@@ -377,7 +377,9 @@ pub fn scan_sets(
     options: &IntegrationOptions,
     include: impl Fn(usize) -> bool + Sync,
 ) -> Result<(ScanSets, IntegrationStats)> {
-    walk_scan(cloud, resolution, options, |i| u16::from(include(i)))
+    walk_scan(cloud, resolution, options, Checked::No, |i| {
+        u16::from(include(i))
+    })
 }
 
 /// The levels of one scan whose points carry levels (`level(i)`, 0 leaves point `i` out), in
@@ -390,15 +392,17 @@ pub fn scan_levels(
     options: &IntegrationOptions,
     level: impl Fn(usize) -> u16 + Sync,
 ) -> Result<(ScanLevels, IntegrationStats)> {
-    walk_scan(cloud, resolution, options, level)
+    walk_scan(cloud, resolution, options, Checked::No, level)
 }
 
-fn walk_scan<B: CellMarks>(
+/// Checks everything that [`scan_sets`] and [`scan_levels`] reject, before any work: the
+/// options, the origin's key, every finite point's key (in double and single precision) and
+/// every ray's length (cut at `max_range`).
+pub(crate) fn check_octomap_scan(
     cloud: &PointCloud,
     resolution: &Resolution,
     options: &IntegrationOptions,
-    level: impl Fn(usize) -> u16 + Sync,
-) -> Result<(ScanBlocks<B>, IntegrationStats)> {
+) -> Result<()> {
     let options = options.validate()?;
     let origin = cloud.origin();
     resolution.key_of(&origin)?;
@@ -430,6 +434,31 @@ fn walk_scan<B: CellMarks>(
     {
         check_ray_length(cut(p), resolution.size())?;
     }
+    Ok(())
+}
+
+/// Whether a scan still needs [`check_octomap_scan`] (a batch checks all its scans first).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Checked {
+    /// Check the scan before walking it.
+    No,
+    /// The caller has checked it.
+    Yes,
+}
+
+pub(crate) fn walk_scan<B: CellMarks>(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    options: &IntegrationOptions,
+    checked: Checked,
+    level: impl Fn(usize) -> u16 + Sync,
+) -> Result<(ScanBlocks<B>, IntegrationStats)> {
+    if checked == Checked::No {
+        check_octomap_scan(cloud, resolution, options)?;
+    }
+    let options = options.validate()?;
+    let origin = cloud.origin();
+    let finite = |p: &Point3<f64>| p.iter().all(|v| v.is_finite());
     let single = |p: &Point3<f64>| [p.x as f32, p.y as f32, p.z as f32];
     let origin32 = single(&origin);
     let max_range = options.max_range;

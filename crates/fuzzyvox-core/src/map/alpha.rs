@@ -1,10 +1,15 @@
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::counts::VoxelCounts;
 use super::logodds::{LogOddsConfig, LogOddsMap, logodds};
+use super::logodds::{SETS_GROUP_POINTS, check_scans};
 use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
-use crate::integrate::{DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, scan_levels};
+use crate::integrate::{
+    BlockLevels, Checked, DepthFrame, IntegrationOptions, IntegrationStats, PointCloud,
+    check_octomap_scan, scan_groups, scan_levels, walk_scan,
+};
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::storage::{BLOCK_CELLS, BlockKey, KeyBox, Resolution, VoxelKey};
 
@@ -171,6 +176,32 @@ impl VoxelMapMut for AlphaCutMap {
         })?;
         stats.voxels_updated = self.inner.apply_levels(&levels);
         Ok(stats)
+    }
+
+    fn integrate_clouds(
+        &mut self,
+        clouds: &[PointCloud],
+        options: &IntegrationOptions,
+    ) -> Result<Vec<IntegrationStats>> {
+        let resolution = self.inner.resolution();
+        check_scans(clouds, |c| check_octomap_scan(c, &resolution, options))?;
+        let mut all = Vec::with_capacity(clouds.len());
+        for group in scan_groups(clouds, SETS_GROUP_POINTS) {
+            let walked = group
+                .par_iter()
+                .map(|cloud| {
+                    walk_scan::<BlockLevels>(cloud, &resolution, options, Checked::Yes, |i| {
+                        u16::try_from(self.config.cuts_of(cloud.confidence_of(i)))
+                            .unwrap_or(u16::MAX)
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?;
+            for (levels, mut stats) in walked {
+                stats.voxels_updated = self.inner.apply_levels(&levels);
+                all.push(stats);
+            }
+        }
+        Ok(all)
     }
 
     fn integrate_depth(

@@ -3,11 +3,12 @@ use rayon::prelude::*;
 use super::config::FuzzyConfig;
 use super::counts::VoxelCounts;
 use super::levels::{Accumulator, Levels};
+use super::logodds::check_scans;
 use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
 use crate::integrate::{
-    DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
-    cloud_evidence, depth_evidence,
+    Checked, DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
+    check_cloud, cloud_evidence, cloud_evidence_checked, depth_evidence, scan_groups,
 };
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::ops::TConorm;
@@ -207,6 +208,10 @@ impl FuzzyMap {
     }
 }
 
+/// Most points in a group of scans walked side by side (each scan's evidence holds two `f32`
+/// per voxel its rays reach, so groups stay smaller than the log-odds map's).
+const EVIDENCE_GROUP_POINTS: usize = 1 << 18;
+
 /// The level of the last evidence value seen (a scan gives many voxels of a block the same
 /// evidence), computed again only for another value.
 #[derive(Default)]
@@ -341,6 +346,36 @@ impl VoxelMapMut for FuzzyMap {
             cloud_evidence(cloud, &c.resolution, &c.evidence, &c.operator, options)?;
         stats.voxels_updated = self.apply_evidence(&evidence);
         Ok(stats)
+    }
+
+    fn integrate_clouds(
+        &mut self,
+        clouds: &[PointCloud],
+        options: &IntegrationOptions,
+    ) -> Result<Vec<IntegrationStats>> {
+        let c = self.config;
+        check_scans(clouds, |cloud| check_cloud(cloud, &c.resolution, options))?;
+        let mut all = Vec::with_capacity(clouds.len());
+        for group in scan_groups(clouds, EVIDENCE_GROUP_POINTS) {
+            let evidence = group
+                .par_iter()
+                .map(|cloud| {
+                    cloud_evidence_checked(
+                        cloud,
+                        &c.resolution,
+                        &c.evidence,
+                        &c.operator,
+                        options,
+                        Checked::Yes,
+                    )
+                })
+                .collect::<Result<Vec<_>>>()?;
+            for (evidence, mut stats) in evidence {
+                stats.voxels_updated = self.apply_evidence(&evidence);
+                all.push(stats);
+            }
+        }
+        Ok(all)
     }
 
     fn integrate_depth(

@@ -5,7 +5,8 @@ use super::counts::VoxelCounts;
 use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result, finite};
 use crate::integrate::{
-    DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanLevels, ScanSets, scan_sets,
+    BlockFlags, Checked, DepthFrame, IntegrationOptions, IntegrationStats, PointCloud, ScanLevels,
+    ScanSets, check_octomap_scan, scan_groups, scan_sets, walk_scan,
 };
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::storage::{BLOCK_CELLS, Block, BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};
@@ -419,6 +420,27 @@ impl VoxelMapMut for LogOddsMap {
         self.integrate_selected(cloud, options, |_| true)
     }
 
+    fn integrate_clouds(
+        &mut self,
+        clouds: &[PointCloud],
+        options: &IntegrationOptions,
+    ) -> Result<Vec<IntegrationStats>> {
+        let resolution = self.config.resolution;
+        check_scans(clouds, |c| check_octomap_scan(c, &resolution, options))?;
+        let mut all = Vec::with_capacity(clouds.len());
+        for group in scan_groups(clouds, SETS_GROUP_POINTS) {
+            let walked = group
+                .par_iter()
+                .map(|c| walk_scan::<BlockFlags>(c, &resolution, options, Checked::Yes, |_| 1))
+                .collect::<Result<Vec<_>>>()?;
+            for (sets, mut stats) in walked {
+                stats.voxels_updated = self.apply_sets(&sets);
+                all.push(stats);
+            }
+        }
+        Ok(all)
+    }
+
     fn integrate_depth(
         &mut self,
         frame: &DepthFrame,
@@ -426,6 +448,18 @@ impl VoxelMapMut for LogOddsMap {
     ) -> Result<IntegrationStats> {
         self.integrate_cloud(&frame.to_cloud()?, options)
     }
+}
+
+/// Most points in a group of scans walked side by side (their sets are two bits per voxel).
+pub(crate) const SETS_GROUP_POINTS: usize = 1 << 20;
+
+/// Runs `check` on every scan, in parallel, and returns the first scan's error in order.
+pub(crate) fn check_scans(
+    clouds: &[PointCloud],
+    check: impl Fn(&PointCloud) -> Result<()> + Sync,
+) -> Result<()> {
+    let checks: Vec<Result<()>> = clouds.par_iter().map(&check).collect();
+    checks.into_iter().collect()
 }
 
 #[cfg(test)]

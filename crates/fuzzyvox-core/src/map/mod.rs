@@ -155,6 +155,26 @@ pub trait VoxelMapMut: VoxelMap {
         options: &IntegrationOptions,
     ) -> Result<IntegrationStats>;
 
+    /// Integrates point clouds, each as one scan, in order: the map becomes, bit for bit, what
+    /// integrating them one after another with [`VoxelMapMut::integrate_cloud`] makes it.
+    /// Returns each scan's statistics.
+    ///
+    /// This crate's maps walk the rays of several scans side by side and apply them in order,
+    /// which is faster for many small scans (a list of depth images, say), and check every
+    /// scan before integrating any, so on error the map is unchanged. The default integrates
+    /// the scans one by one and stops at the first error, leaving the scans before it
+    /// integrated.
+    fn integrate_clouds(
+        &mut self,
+        clouds: &[PointCloud],
+        options: &IntegrationOptions,
+    ) -> Result<Vec<IntegrationStats>> {
+        clouds
+            .iter()
+            .map(|cloud| self.integrate_cloud(cloud, options))
+            .collect()
+    }
+
     /// Integrates one interval depth image as one scan. On error the map is unchanged.
     fn integrate_depth(
         &mut self,
