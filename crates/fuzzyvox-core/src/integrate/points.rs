@@ -136,8 +136,9 @@ pub(crate) fn cloud_evidence_checked(
 /// kernel.
 struct FreeAlongRay<'a, 'g> {
     acc: &'a mut AccessorMut<'g, super::Evidence>,
-    /// The block the walk is in.
+    /// The block the walk is in, and its storage position in the scan's evidence.
     block: BlockKey,
+    position: usize,
     /// Key steps from the voxel about to be visited to the end voxel (the walk takes exactly
     /// as many steps as the keys differ).
     steps_to_end: i32,
@@ -153,6 +154,7 @@ impl CellSink for FreeAlongRay<'_, '_> {
     #[inline(always)]
     fn enter(&mut self, block: BlockKey) {
         self.block = block;
+        self.position = self.acc.enter(block);
     }
 
     #[inline(always)]
@@ -167,7 +169,7 @@ impl CellSink for FreeAlongRay<'_, '_> {
         }
         // Occupied evidence is never negative, so raising it to 0 (as `raise` would) changes
         // nothing.
-        let evidence = self.acc.cell_of_block(self.block, cell);
+        let evidence = self.acc.cell_at(self.position, cell);
         evidence.free = evidence.free.max(self.free);
     }
 }
@@ -252,6 +254,7 @@ impl Ray {
             let mut sink = FreeAlongRay {
                 acc,
                 block: origin_key.block(),
+                position: 0,
                 steps_to_end,
                 near_end,
                 reach,

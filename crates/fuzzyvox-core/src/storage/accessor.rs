@@ -61,13 +61,25 @@ impl<'a, C: Copy + Default> AccessorMut<'a, C> {
     pub fn cell_of_block(&mut self, block: BlockKey, cell: usize) -> &mut C {
         let position = match self.last {
             Some((cached, position)) if cached == block => position,
-            _ => {
-                let position = self.grid.ensure_block(block);
-                self.grid.mark(position);
-                self.last = Some((block, position));
-                position
-            }
+            _ => self.enter(block),
         };
+        self.grid.cell_at_mut_unrecorded(position, cell)
+    }
+
+    /// Makes `block` the accessor's current block, allocating it when needed, and returns its
+    /// storage position for [`AccessorMut::cell_at`].
+    #[inline]
+    pub fn enter(&mut self, block: BlockKey) -> usize {
+        let position = self.grid.ensure_block(block);
+        self.grid.mark(position);
+        self.last = Some((block, position));
+        position
+    }
+
+    /// Cell `cell` of the block at storage position `position`, which [`AccessorMut::enter`]
+    /// returned. Panics for a position no block has.
+    #[inline]
+    pub fn cell_at(&mut self, position: usize, cell: usize) -> &mut C {
         self.grid.cell_at_mut_unrecorded(position, cell)
     }
 }
