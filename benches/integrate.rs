@@ -139,8 +139,72 @@ fn projective_integration(c: &mut Criterion) {
     group.finish();
 }
 
+/// Point queries on scan.dat's 0.05 m maps: the class of 4096 voxels spread over the scan's
+/// box (observed and unobserved ones alike), one `class_at` each; the time is for all 4096.
+fn point_queries(c: &mut Criterion) {
+    let Some(dir) = data_dir() else { return };
+    let cloud = read_text_cloud(&dir.join("octomap-samples/scan.dat"), Point3::origin())
+        .expect("reading scan.dat");
+    let resolution = 0.05;
+    let mut fuzzy = FuzzyMap::new(FuzzyConfig::new(resolution).unwrap()).unwrap();
+    fuzzy
+        .integrate_cloud(&cloud, &IntegrationOptions::default())
+        .unwrap();
+    let mut logodds = LogOddsMap::new(LogOddsConfig::new(resolution).unwrap()).unwrap();
+    logodds
+        .integrate_cloud(&cloud, &IntegrationOptions::default())
+        .unwrap();
+    // Keys spread over the box of the scan's end points, from a fixed sequence.
+    let r = fuzzy.resolution();
+    let keys_of: Vec<_> = cloud
+        .points()
+        .iter()
+        .map(|p| r.key_of(p).unwrap())
+        .collect();
+    let lo = keys_of.iter().fold([i32::MAX; 3], |m, k| {
+        [m[0].min(k.x), m[1].min(k.y), m[2].min(k.z)]
+    });
+    let hi = keys_of.iter().fold([i32::MIN; 3], |m, k| {
+        [m[0].max(k.x), m[1].max(k.y), m[2].max(k.z)]
+    });
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = |lo: i32, hi: i32| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        lo + ((state >> 33) % u64::from((hi - lo + 1) as u32)) as i32
+    };
+    let keys: Vec<_> = (0..4096)
+        .map(|i| {
+            // Every other key is an end point's voxel (observed), the rest anywhere in the box.
+            if i % 2 == 0 {
+                keys_of[(i * 21) % keys_of.len()]
+            } else {
+                fuzzyvox::VoxelKey::new(next(lo[0], hi[0]), next(lo[1], hi[1]), next(lo[2], hi[2]))
+            }
+        })
+        .collect();
+    let mut group = c.benchmark_group("point_query_scan_dat_0.05m");
+    group.bench_function("fuzzy_class_at_4096", |b| {
+        b.iter(|| {
+            keys.iter()
+                .filter(|k| fuzzy.class_at(**k) == fuzzyvox::VoxelClass::Occupied)
+                .count()
+        })
+    });
+    group.bench_function("logodds_class_at_4096", |b| {
+        b.iter(|| {
+            keys.iter()
+                .filter(|k| logodds.class_at(**k) == fuzzyvox::VoxelClass::Occupied)
+                .count()
+        })
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    point_queries,
     ray_integration,
     log_odds_integration,
     alpha_integration,

@@ -152,7 +152,7 @@ mod tests {
     fn memberships_grid(map: &FuzzyMap) -> crate::storage::BlockGrid<Memberships> {
         let mut grid = crate::storage::BlockGrid::new();
         for (key, levels) in map.grid().cells() {
-            *grid.cell_or_insert(key) = map.accumulator().memberships(*levels);
+            *grid.cell_or_insert(key) = map.accumulator().memberships(levels);
         }
         grid
     }
@@ -181,7 +181,7 @@ mod tests {
                 },
                 measures: config.measures,
             },
-            blocks: stored_blocks::store(&memberships_grid(&map)),
+            blocks: stored_blocks::store_dense(&memberships_grid(&map)),
         };
         let mut bytes = mapfile::encode(MapKind::Fuzzy, Some(config.operator.family()), 0.25, &old);
         // Rewrite the header as version 1 and fix the checksum.

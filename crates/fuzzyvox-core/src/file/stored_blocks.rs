@@ -5,7 +5,7 @@ use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 
 use crate::error::FormatError;
-use crate::storage::{BLOCK_CELLS, Block, BlockGrid, BlockKey};
+use crate::storage::{BLOCK_CELLS, Block, BlockGrid, BlockKey, CellBits, PackedGrid};
 
 /// One stored block.
 #[derive(Serialize, Deserialize)]
@@ -14,8 +14,22 @@ pub(crate) struct StoredBlock<C> {
     pub(crate) cells: Vec<C>,
 }
 
-/// The grid's blocks in key order.
-pub(crate) fn store<C: Copy + Default>(grid: &BlockGrid<C>) -> Vec<StoredBlock<C>> {
+/// The grid's blocks in key order, each as its 512 cells, however the grid packs them.
+pub(crate) fn store<C: CellBits>(grid: &PackedGrid<C>) -> Vec<StoredBlock<C>> {
+    grid.sorted_block_keys()
+        .into_iter()
+        .filter_map(|key| {
+            grid.block(key).map(|b| StoredBlock {
+                key,
+                cells: b.iter().collect(),
+            })
+        })
+        .collect()
+}
+
+/// A dense grid's blocks in key order (files of older versions, written by tests).
+#[cfg(test)]
+pub(crate) fn store_dense<C: Copy + Default>(grid: &BlockGrid<C>) -> Vec<StoredBlock<C>> {
     grid.sorted_block_keys()
         .into_iter()
         .filter_map(|key| {

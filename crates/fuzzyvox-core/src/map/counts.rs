@@ -1,7 +1,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::measures::VoxelClass;
-use crate::storage::BlockGrid;
+use crate::storage::{BlockGrid, CellBits, ClassCounts, PackedGrid};
 
 /// Voxel counts per class over a map's allocated blocks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -29,12 +29,21 @@ impl VoxelCounts {
 
     /// Sums the per-block class counts of a grid (no cell is visited).
     pub fn of_grid<C: Copy + Default>(grid: &BlockGrid<C>) -> Self {
+        Self::of_summaries(grid.blocks().map(|(_, block)| &block.summary))
+    }
+
+    /// Sums the per-block class counts of a packed grid (no cell is visited).
+    pub fn of_packed<C: CellBits>(grid: &PackedGrid<C>) -> Self {
+        Self::of_summaries(grid.blocks().map(|(_, block)| &block.summary))
+    }
+
+    fn of_summaries<'a>(summaries: impl Iterator<Item = &'a ClassCounts>) -> Self {
         let mut counts = Self::default();
-        for (_, block) in grid.blocks() {
-            counts.occupied += block.summary.get(VoxelClass::Occupied);
-            counts.free += block.summary.get(VoxelClass::Free);
-            counts.ambiguous += block.summary.get(VoxelClass::Ambiguous);
-            counts.unknown += block.summary.get(VoxelClass::Unknown);
+        for summary in summaries {
+            counts.occupied += summary.get(VoxelClass::Occupied);
+            counts.free += summary.get(VoxelClass::Free);
+            counts.ambiguous += summary.get(VoxelClass::Ambiguous);
+            counts.unknown += summary.get(VoxelClass::Unknown);
         }
         counts
     }

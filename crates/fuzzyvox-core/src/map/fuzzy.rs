@@ -12,7 +12,9 @@ use crate::integrate::{
 };
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::ops::TConorm;
-use crate::storage::{BLOCK_CELLS, BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};
+use crate::storage::{
+    BLOCK_CELLS, Block, BlockGrid, BlockKey, KeyBox, PackedGrid, Resolution, VoxelKey,
+};
 
 /// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
 /// and how free (μE), each aggregated from evidence with a t-conorm `S`:
@@ -39,7 +41,7 @@ use crate::storage::{BLOCK_CELLS, BlockGrid, BlockKey, KeyBox, Resolution, Voxel
 pub struct FuzzyMap {
     config: FuzzyConfig,
     accumulator: Accumulator,
-    grid: BlockGrid<Levels>,
+    grid: PackedGrid<Levels>,
 }
 
 impl FuzzyMap {
@@ -49,7 +51,7 @@ impl FuzzyMap {
         Ok(Self {
             accumulator: Accumulator::new(config.operator),
             config,
-            grid: BlockGrid::new(),
+            grid: PackedGrid::new(),
         })
     }
 
@@ -70,7 +72,7 @@ impl FuzzyMap {
 
     /// The underlying block storage (read-only): each voxel's [`Levels`], which
     /// [`Accumulator::memberships`] reads as memberships.
-    pub fn grid(&self) -> &BlockGrid<Levels> {
+    pub fn grid(&self) -> &PackedGrid<Levels> {
         &self.grid
     }
 
@@ -106,7 +108,13 @@ impl FuzzyMap {
             )));
         }
         let acc = self.accumulator;
-        self.update(&other.grid, |cell, s: &Levels, _| {
+        let blocks: Vec<(BlockKey, Block<Levels>)> = other
+            .grid
+            .blocks()
+            .map(|(key, block)| (key, block.unpack()))
+            .collect();
+        let sources = blocks.iter().map(|(key, block)| (*key, block)).collect();
+        self.update(sources, |cell, s: &Levels, _| {
             if *s == Levels::default() {
                 return false;
             }
@@ -125,7 +133,7 @@ impl FuzzyMap {
         evidence_of: impl Fn(&C) -> (f32, f32) + Sync,
     ) -> usize {
         let acc = self.accumulator;
-        self.update(source, |cell, s, memo| {
+        self.update(source.blocks().collect(), |cell, s, memo| {
             let (o, e) = evidence_of(s);
             if o <= 0.0 && e <= 0.0 {
                 return false;
@@ -145,12 +153,12 @@ impl FuzzyMap {
     /// and marking only blocks whose levels changed. Returns the number of cells updated.
     fn update<C: Copy + Default + Sync>(
         &mut self,
-        source: &BlockGrid<C>,
+        sources: Vec<(BlockKey, &Block<C>)>,
         update: impl Fn(&mut Levels, &C, &mut LevelMemo) -> bool + Sync,
     ) -> usize {
         let acc = self.accumulator;
         let measures = self.config.measures;
-        self.grid.update_from(source, |block, source| {
+        self.grid.update_blocks(sources, |block, source| {
             let mut updated = 0;
             let mut changed = false;
             // Cells of a block often hold the same levels (space a scan cleared once): classify
@@ -176,7 +184,7 @@ impl FuzzyMap {
 
     /// Voxel counts per class over the allocated blocks, from the block summaries.
     pub fn counts(&self) -> VoxelCounts {
-        VoxelCounts::of_grid(&self.grid)
+        VoxelCounts::of_packed(&self.grid)
     }
 
     /// Whether any voxel in `region` is of class `class` (voxels of unallocated blocks are
@@ -194,12 +202,10 @@ impl FuzzyMap {
 
     /// Rebuilds a map from its configuration and storage (used by the file reader, which has
     /// validated both).
-    pub(crate) fn from_parts(config: FuzzyConfig, mut grid: BlockGrid<Levels>) -> Self {
+    pub(crate) fn from_parts(config: FuzzyConfig, grid: BlockGrid<Levels>) -> Self {
         let (acc, measures) = (Accumulator::new(config.operator), config.measures);
-        let (_, blocks) = grid.blocks_mut();
-        blocks
-            .par_iter_mut()
-            .for_each(|b| b.refresh_summary(|l| measures.classify(acc.memberships(*l))));
+        let mut grid = PackedGrid::from_dense(&grid);
+        grid.refresh_summaries(|l| measures.classify(acc.memberships(*l)));
         Self {
             config,
             accumulator: acc,
@@ -282,8 +288,8 @@ impl VoxelMap for FuzzyMap {
         Box::new(
             self.grid
                 .cells()
-                .filter(|(_, l)| **l != Levels::default())
-                .map(move |(k, l)| (k, acc.memberships(*l))),
+                .filter(|(_, l)| *l != Levels::default())
+                .map(move |(k, l)| (k, acc.memberships(l))),
         )
     }
 
@@ -306,12 +312,14 @@ impl VoxelMap for FuzzyMap {
     fn memberships_at(&self, key: VoxelKey) -> Memberships {
         self.grid
             .cell(key)
-            .map_or_else(Memberships::default, |l| self.accumulator.memberships(*l))
+            .map_or_else(Memberships::default, |l| self.accumulator.memberships(l))
     }
 
     fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
         match self.grid.block(key) {
-            Some(block) => self.accumulator.memberships_into(&block.cells, out),
+            Some(block) => self
+                .accumulator
+                .memberships_into(&block.unpack().cells, out),
             None => out.fill(Memberships::default()),
         }
     }
@@ -319,7 +327,7 @@ impl VoxelMap for FuzzyMap {
     fn block_stamps(&self, key: BlockKey, out: &mut [u64; BLOCK_CELLS]) -> bool {
         match self.grid.block(key) {
             Some(block) => {
-                for (stamp, levels) in out.iter_mut().zip(&block.cells) {
+                for (stamp, levels) in out.iter_mut().zip(block.iter()) {
                     *stamp = levels.packed();
                 }
             }

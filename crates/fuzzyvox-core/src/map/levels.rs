@@ -59,6 +59,13 @@ impl Levels {
     }
 }
 
+impl crate::storage::CellBits for Levels {
+    #[inline]
+    fn bits(&self) -> u64 {
+        self.packed()
+    }
+}
+
 /// Levels per `g(½)`: a membership of one half is `2²⁰` levels.
 const LEVELS_PER_HALF: f64 = (1u32 << 20) as f64;
 

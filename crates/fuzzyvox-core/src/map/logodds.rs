@@ -9,7 +9,9 @@ use crate::integrate::{
     ScanSets, check_octomap_scan, scan_groups, scan_sets, walk_scan,
 };
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
-use crate::storage::{BLOCK_CELLS, Block, BlockGrid, BlockKey, KeyBox, Resolution, VoxelKey};
+use crate::storage::{
+    BLOCK_CELLS, Block, BlockGrid, BlockKey, CellBits, KeyBox, PackedGrid, Resolution, VoxelKey,
+};
 
 /// One log-odds cell: `ln(p / (1 - p))` of being occupied, NaN when never observed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -18,6 +20,13 @@ pub struct LogOdds(pub f32);
 impl Default for LogOdds {
     fn default() -> Self {
         Self(f32::NAN)
+    }
+}
+
+impl CellBits for LogOdds {
+    #[inline]
+    fn bits(&self) -> u64 {
+        u64::from(self.0.to_bits())
     }
 }
 
@@ -129,7 +138,7 @@ pub struct LogOddsMap {
     miss: f32,
     min: f32,
     max: f32,
-    grid: BlockGrid<LogOdds>,
+    grid: PackedGrid<LogOdds>,
 }
 
 /// One cell's updates in a scan, shared by [`LogOddsMap::apply_sets`] and
@@ -215,12 +224,10 @@ impl LogOddsMap {
         Ok(Self::from_parts(config, BlockGrid::new()))
     }
 
-    pub(crate) fn from_parts(config: LogOddsConfig, mut grid: BlockGrid<LogOdds>) -> Self {
+    pub(crate) fn from_parts(config: LogOddsConfig, grid: BlockGrid<LogOdds>) -> Self {
         let measures = config.measures;
-        let (_, blocks) = grid.blocks_mut();
-        blocks
-            .par_iter_mut()
-            .for_each(|b| b.refresh_summary(|c| measures.classify(c.memberships())));
+        let mut grid = PackedGrid::from_dense(&grid);
+        grid.refresh_summaries(|c| measures.classify(c.memberships()));
         Self {
             hit: logodds(config.prob_hit),
             miss: logodds(config.prob_miss),
@@ -237,13 +244,13 @@ impl LogOddsMap {
     }
 
     /// The underlying block storage (read-only).
-    pub fn grid(&self) -> &BlockGrid<LogOdds> {
+    pub fn grid(&self) -> &PackedGrid<LogOdds> {
         &self.grid
     }
 
     /// The log-odds cell at `key`.
     pub fn log_odds_at(&self, key: VoxelKey) -> LogOdds {
-        self.grid.cell(key).copied().unwrap_or_default()
+        self.grid.cell(key).unwrap_or_default()
     }
 
     /// The per-cell update that both appliers share.
@@ -316,7 +323,7 @@ impl LogOddsMap {
 
     /// Voxel counts per class over the allocated blocks.
     pub fn counts(&self) -> VoxelCounts {
-        VoxelCounts::of_grid(&self.grid)
+        VoxelCounts::of_packed(&self.grid)
     }
 
     /// Whether any voxel in `region` is of class `class` (voxels of unallocated blocks are
@@ -363,7 +370,7 @@ impl VoxelMap for LogOddsMap {
     fn block_memberships(&self, key: BlockKey, out: &mut [Memberships; BLOCK_CELLS]) {
         match self.grid.block(key) {
             Some(block) => {
-                for (m, cell) in out.iter_mut().zip(&block.cells) {
+                for (m, cell) in out.iter_mut().zip(block.iter()) {
                     *m = cell.memberships();
                 }
             }
@@ -374,7 +381,7 @@ impl VoxelMap for LogOddsMap {
     fn block_stamps(&self, key: BlockKey, out: &mut [u64; BLOCK_CELLS]) -> bool {
         match self.grid.block(key) {
             Some(block) => {
-                for (stamp, cell) in out.iter_mut().zip(&block.cells) {
+                for (stamp, cell) in out.iter_mut().zip(block.iter()) {
                     *stamp = u64::from(cell.0.to_bits());
                 }
             }

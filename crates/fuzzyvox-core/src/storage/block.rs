@@ -34,6 +34,11 @@ impl ClassCounts {
         Self(counts)
     }
 
+    /// Counts per class, in [`VoxelClass::index`] order (each at most [`BLOCK_CELLS`]).
+    pub fn from_counts(counts: [usize; 4]) -> Self {
+        Self(counts.map(|n| u16::try_from(n).unwrap_or(u16::MAX)))
+    }
+
     /// Records that one cell changed class from `from` to `to`.
     #[inline]
     pub fn moved(&mut self, from: VoxelClass, to: VoxelClass) {

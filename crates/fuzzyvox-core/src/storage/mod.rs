@@ -11,10 +11,12 @@ mod accessor;
 mod block;
 mod grid;
 mod key;
+mod packed;
 mod region;
 
 pub use accessor::{Accessor, AccessorMut};
 pub use block::{BLOCK_CELLS, BLOCK_SIDE, Block, ClassCounts};
 pub use grid::BlockGrid;
 pub use key::{BlockKey, KEY_LIMIT, Resolution, VoxelKey};
+pub use packed::{CellBits, PackedBlock, PackedGrid};
 pub use region::KeyBox;
