@@ -1,7 +1,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::mapfile;
-use super::stored_blocks::{self, StoredBlock};
+use super::stored_blocks::{self, PackedStoredBlock, StoredBlock};
 use crate::error::{FormatError, Result};
 use crate::integrate::EvidenceModel;
 use crate::map::MapKind;
@@ -10,11 +10,18 @@ use crate::measures::{MeasureConfig, Memberships};
 use crate::ops::TConorm;
 use crate::storage::Resolution;
 
-/// A format version 3 body: memberships as levels of the operator's generator.
+/// A format version 3 body: memberships as levels of the operator's generator, 512 per block.
 #[derive(Serialize, Deserialize)]
 struct Body {
     config: FuzzyConfig,
     blocks: Vec<StoredBlock<Levels>>,
+}
+
+/// A format version 4 body: levels as version 3, each block's distinct values and cell codes.
+#[derive(Serialize, Deserialize)]
+struct BodyV4 {
+    config: FuzzyConfig,
+    blocks: Vec<PackedStoredBlock<Levels>>,
 }
 
 /// A format version 2 body: memberships as `f32`.
@@ -80,9 +87,9 @@ impl FuzzyMap {
             MapKind::Fuzzy,
             Some(config.operator.family()),
             config.resolution.size(),
-            &Body {
+            &BodyV4 {
                 config,
-                blocks: stored_blocks::store(self.grid()),
+                blocks: stored_blocks::store_packed(self.grid()),
             },
         )
     }
@@ -124,6 +131,14 @@ impl FuzzyMap {
                             cells: b.cells.iter().map(|m| acc.levels(*m)).collect(),
                         })
                         .collect(),
+                }
+            }
+            None if header.version >= 4 => {
+                let body: BodyV4 =
+                    postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
+                Body {
+                    config: body.config,
+                    blocks: stored_blocks::unpack_stored(body.blocks)?,
                 }
             }
             None => postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?,
@@ -204,10 +219,45 @@ mod tests {
             crate::map::VoxelMap::memberships_at(&map, key)
         );
         // A version from the future is refused with its number.
-        bytes[8..10].copy_from_slice(&4u16.to_le_bytes());
+        bytes[8..10].copy_from_slice(&5u16.to_le_bytes());
         assert!(matches!(
             FuzzyMap::decode(&bytes),
-            Err(FormatError::UnsupportedVersion(4))
+            Err(FormatError::UnsupportedVersion(5))
         ));
+    }
+
+    /// A version 3 file (512 levels per block) loads as the map it was written from.
+    #[test]
+    fn version_3_files_load_as_written() {
+        let mut map = FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap();
+        let points = (0..200)
+            .map(|i| {
+                let a = f64::from(i) * 0.1;
+                nalgebra::Point3::new(2.0 * a.cos(), 2.0 * a.sin(), 0.3 * a.sin())
+            })
+            .collect();
+        let cloud = crate::integrate::PointCloud::new(nalgebra::Point3::new(0.1, 0.0, 0.0), points)
+            .unwrap();
+        crate::map::VoxelMapMut::integrate_cloud(&mut map, &cloud, &Default::default()).unwrap();
+        let config = *map.config();
+        let v3 = mapfile::encode(
+            MapKind::Fuzzy,
+            Some(config.operator.family()),
+            0.2,
+            &Body {
+                config,
+                blocks: stored_blocks::store(map.grid()),
+            },
+        );
+        let v3 = mapfile::with_version(v3, 3);
+        let loaded = FuzzyMap::decode(&v3).unwrap();
+        assert_eq!(loaded.to_bytes(), map.to_bytes());
+        // Version 4 stores the same map in fewer bytes.
+        assert!(
+            map.to_bytes().len() < v3.len() / 2,
+            "{} against {}",
+            map.to_bytes().len(),
+            v3.len()
+        );
     }
 }

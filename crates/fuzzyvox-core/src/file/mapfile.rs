@@ -5,7 +5,7 @@
 //! | bytes | field |
 //! |---|---|
 //! | 0..8 | magic `FUZZYVOX` |
-//! | 8..10 | format version (3; 1 and 2 are still read) |
+//! | 8..10 | format version (4; 1 to 3 are still read) |
 //! | 10 | map kind (1 fuzzy, 2 log-odds, 3 alpha-cut) |
 //! | 11 | operator family code (255: none) |
 //! | 12..20 | operator parameter (f64; 0 when the family has none) |
@@ -25,15 +25,30 @@ use crate::ops::Family;
 
 /// The first eight bytes of every native map file.
 pub const MAGIC: &[u8; 8] = b"FUZZYVOX";
-const VERSION: u16 = 3;
+const VERSION: u16 = 4;
 /// The oldest version still read. Version 2 added the evidence model's kind and free reach to
 /// fuzzy maps' settings; a version 1 fuzzy map was built with the paper's model and loads as
 /// such. Version 3 stores a fuzzy map's memberships as levels of its operator's generator
 /// (exact accumulation, `map::Accumulator`); a version 1 or 2 fuzzy map's `f32` memberships are
-/// converted to the nearest levels as it loads. Log-odds and alpha-cut bodies are the same in both.
+/// converted to the nearest levels as it loads. Log-odds and alpha-cut bodies are the same in
+/// versions 1 to 3. Version 4 stores each block's distinct values once and each cell's index
+/// among them in the fewest bits (`stored_blocks::PackedStoredBlock`) instead of 512 cells.
 const OLDEST_VERSION: u16 = 1;
 const HEADER_LEN: usize = 40;
 const NO_OPERATOR: u8 = 255;
+
+/// `bytes` (a whole map file) relabelled as format version `version`, checksum fixed: how
+/// tests make files of older versions.
+#[cfg(test)]
+pub(crate) fn with_version(mut bytes: Vec<u8>, version: u16) -> Vec<u8> {
+    bytes[8..10].copy_from_slice(&version.to_le_bytes());
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&bytes[..36]);
+    crc.update(&bytes[40..]);
+    let sum = crc.finalize().to_le_bytes();
+    bytes[36..40].copy_from_slice(&sum);
+    bytes
+}
 
 /// The kind's code in a file header.
 fn code_of(kind: MapKind) -> u8 {
