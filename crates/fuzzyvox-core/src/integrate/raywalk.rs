@@ -26,6 +26,52 @@ pub fn walk_ray(
     });
 }
 
+/// The exact walk's set-up, shared by [`walk_ray_until`] and [`walk_ray_cells`]: per axis the
+/// step (±1), the ray parameter t at the next voxel border and the t it takes to cross one
+/// voxel (axes that need no step get infinite t and never win a comparison), and the number
+/// of voxels to visit.
+struct ExactSetup {
+    step: [i32; 3],
+    t: [f64; 3],
+    delta: [f64; 3],
+    remaining: u64,
+}
+
+impl ExactSetup {
+    #[inline(always)]
+    fn new(
+        resolution: &Resolution,
+        from: &Point3<f64>,
+        to: &Point3<f64>,
+        start: VoxelKey,
+        end: VoxelKey,
+    ) -> Self {
+        let direction = to - from;
+        let size = resolution.size();
+        let axis = |current: i32, target: i32, from: f64, d: f64| -> (i32, f64, f64) {
+            if current == target || d == 0.0 {
+                (0, f64::INFINITY, f64::INFINITY)
+            } else {
+                let step = if d > 0.0 { 1 } else { -1 };
+                let border = f64::from(current + i32::from(d > 0.0)) * size;
+                (step, (border - from) / d, size / d.abs())
+            }
+        };
+        let (step_x, t_x, delta_x) = axis(start.x, end.x, from.x, direction.x);
+        let (step_y, t_y, delta_y) = axis(start.y, end.y, from.y, direction.y);
+        let (step_z, t_z, delta_z) = axis(start.z, end.z, from.z, direction.z);
+        let remaining = (i64::from(end.x) - i64::from(start.x)).unsigned_abs()
+            + (i64::from(end.y) - i64::from(start.y)).unsigned_abs()
+            + (i64::from(end.z) - i64::from(start.z)).unsigned_abs();
+        Self {
+            step: [step_x, step_y, step_z],
+            t: [t_x, t_y, t_z],
+            delta: [delta_x, delta_y, delta_z],
+            remaining,
+        }
+    }
+}
+
 /// [`walk_ray`] that stops as soon as `visit` returns [`ControlFlow::Break`], and returns that
 /// break value (for ray casts that look for the first voxel of some kind).
 #[inline]
@@ -37,26 +83,13 @@ pub fn walk_ray_until<B>(
     end: VoxelKey,
     mut visit: impl FnMut(VoxelKey) -> ControlFlow<B>,
 ) -> ControlFlow<B> {
-    let direction = to - from;
-    let size = resolution.size();
-    // Per axis: the step (±1), the ray parameter t at the next voxel border, and the t it
-    // takes to cross one voxel. Axes that need no step never win the comparison below.
-    let axis = |current: i32, target: i32, from: f64, d: f64| -> (i32, f64, f64) {
-        if current == target || d == 0.0 {
-            (0, f64::INFINITY, f64::INFINITY)
-        } else {
-            let step = if d > 0.0 { 1 } else { -1 };
-            let border = f64::from(current + i32::from(d > 0.0)) * size;
-            (step, (border - from) / d, size / d.abs())
-        }
-    };
-    let (step_x, mut t_x, delta_x) = axis(start.x, end.x, from.x, direction.x);
-    let (step_y, mut t_y, delta_y) = axis(start.y, end.y, from.y, direction.y);
-    let (step_z, mut t_z, delta_z) = axis(start.z, end.z, from.z, direction.z);
+    let ExactSetup {
+        step: [step_x, step_y, step_z],
+        t: [mut t_x, mut t_y, mut t_z],
+        delta: [delta_x, delta_y, delta_z],
+        mut remaining,
+    } = ExactSetup::new(resolution, from, to, start, end);
     let (mut x, mut y, mut z) = (start.x, start.y, start.z);
-    let mut remaining = (i64::from(end.x) - i64::from(x)).unsigned_abs()
-        + (i64::from(end.y) - i64::from(y)).unsigned_abs()
-        + (i64::from(end.z) - i64::from(z)).unsigned_abs();
     while remaining > 0 {
         visit(VoxelKey::new(x, y, z))?;
         remaining -= 1;
@@ -98,24 +131,13 @@ pub fn walk_ray_cells(
     end: VoxelKey,
     sink: &mut impl super::octomap_walk::CellSink,
 ) {
-    let direction = to - from;
-    let size = resolution.size();
-    let axis = |current: i32, target: i32, from: f64, d: f64| -> (i32, f64, f64) {
-        if current == target || d == 0.0 {
-            (0, f64::INFINITY, f64::INFINITY)
-        } else {
-            let step = if d > 0.0 { 1 } else { -1 };
-            let border = f64::from(current + i32::from(d > 0.0)) * size;
-            (step, (border - from) / d, size / d.abs())
-        }
-    };
-    let (step_x, mut t_x, delta_x) = axis(start.x, end.x, from.x, direction.x);
-    let (step_y, mut t_y, delta_y) = axis(start.y, end.y, from.y, direction.y);
-    let (step_z, mut t_z, delta_z) = axis(start.z, end.z, from.z, direction.z);
+    let ExactSetup {
+        step: [step_x, step_y, step_z],
+        t: [mut t_x, mut t_y, mut t_z],
+        delta: [delta_x, delta_y, delta_z],
+        mut remaining,
+    } = ExactSetup::new(resolution, from, to, start, end);
     let (mut x, mut y, mut z) = (start.x, start.y, start.z);
-    let mut remaining = (i64::from(end.x) - i64::from(x)).unsigned_abs()
-        + (i64::from(end.y) - i64::from(y)).unsigned_abs()
-        + (i64::from(end.z) - i64::from(z)).unsigned_abs();
     if remaining == 0 {
         return;
     }

@@ -236,34 +236,15 @@ impl<C: Copy + Default> BlockGrid<C> {
         class: VoxelClass,
         classify: impl Fn(&C) -> VoxelClass,
     ) -> bool {
-        let box_blocks = region.block_count();
-        if class == VoxelClass::Unknown && box_blocks > self.blocks.len() as u128 {
-            // More blocks in the box than allocated in the whole grid: one is missing.
-            return true;
-        }
-        let decide = |key: BlockKey, block: &Block<C>| {
-            if block.summary.get(class) == 0 {
-                false
-            } else if region.covers_block(key) {
-                true
-            } else {
-                block
-                    .cells
-                    .iter()
-                    .enumerate()
-                    .any(|(i, c)| region.contains(key.voxel(i)) && classify(c) == class)
-            }
-        };
-        if box_blocks <= self.blocks.len() as u128 {
-            region.blocks().any(|key| match self.block(key) {
-                Some(block) => decide(key, block),
-                None => class == VoxelClass::Unknown,
-            })
-        } else {
-            self.blocks()
-                .filter(|(key, _)| region.meets_block(*key))
-                .any(|(key, block)| decide(key, block))
-        }
+        super::region::any_of_class_in_box(
+            region,
+            class,
+            self.blocks.len(),
+            |key| self.block(key),
+            self.blocks(),
+            |block| block.summary,
+            |block, i| block.cells.get(i).map_or(VoxelClass::Unknown, &classify),
+        )
     }
 
     /// Allocated blocks that meet `region`, visiting whichever is smaller: the box's blocks or

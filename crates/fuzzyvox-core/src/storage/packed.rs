@@ -395,32 +395,15 @@ impl<C: CellBits> PackedGrid<C> {
         class: VoxelClass,
         classify: impl Fn(&C) -> VoxelClass,
     ) -> bool {
-        let box_blocks = region.block_count();
-        if class == VoxelClass::Unknown && box_blocks > self.blocks.len() as u128 {
-            return true;
-        }
-        let decide = |key: BlockKey, block: &PackedBlock<C>| {
-            if block.summary.get(class) == 0 {
-                false
-            } else if region.covers_block(key) {
-                true
-            } else {
-                block
-                    .iter()
-                    .enumerate()
-                    .any(|(i, c)| region.contains(key.voxel(i)) && classify(&c) == class)
-            }
-        };
-        if box_blocks <= self.blocks.len() as u128 {
-            region.blocks().any(|key| match self.block(key) {
-                Some(block) => decide(key, block),
-                None => class == VoxelClass::Unknown,
-            })
-        } else {
-            self.blocks()
-                .filter(|(key, _)| region.meets_block(*key))
-                .any(|(key, block)| decide(key, block))
-        }
+        super::region::any_of_class_in_box(
+            region,
+            class,
+            self.blocks.len(),
+            |key| self.block(key),
+            self.blocks(),
+            |block| block.summary,
+            |block, i| classify(&block.get(i)),
+        )
     }
 
     /// Heap memory held by the grid, in bytes (blocks and their cells, key list, versions and

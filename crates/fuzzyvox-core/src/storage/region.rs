@@ -1,6 +1,8 @@
 use nalgebra::Point3;
 
+use super::block::ClassCounts;
 use super::key::{BlockKey, Resolution, VoxelKey};
+use crate::class::VoxelClass;
 use crate::error::Result;
 
 /// An axis-aligned box of voxel keys, bounds inclusive.
@@ -69,6 +71,48 @@ impl KeyBox {
         (lo.z..=hi.z).flat_map(move |z| {
             (lo.y..=hi.y).flat_map(move |y| (lo.x..=hi.x).map(move |x| BlockKey::new(x, y, z)))
         })
+    }
+}
+
+/// Whether any voxel of `region` is of class `class` in a grid of `allocated` blocks, answered
+/// from each block's class counts (`summary`) wherever a block lies wholly inside the box or
+/// has no cell of that class, and from its cells (`cell_class`) only for blocks the box's
+/// boundary cuts. Voxels of unallocated blocks are unknown. Visits whichever is fewer: the
+/// box's blocks (through `block`) or the allocated ones (`blocks`). Shared by
+/// [`BlockGrid`](super::BlockGrid) and [`PackedGrid`](super::PackedGrid).
+pub(super) fn any_of_class_in_box<B: Copy>(
+    region: &KeyBox,
+    class: VoxelClass,
+    allocated: usize,
+    block: impl Fn(BlockKey) -> Option<B>,
+    blocks: impl Iterator<Item = (BlockKey, B)>,
+    summary: impl Fn(B) -> ClassCounts,
+    cell_class: impl Fn(B, usize) -> VoxelClass,
+) -> bool {
+    let box_blocks = region.block_count();
+    if class == VoxelClass::Unknown && box_blocks > allocated as u128 {
+        // More blocks in the box than allocated in the whole grid: one is missing.
+        return true;
+    }
+    let decide = |key: BlockKey, b: B| {
+        if summary(b).get(class) == 0 {
+            false
+        } else if region.covers_block(key) {
+            true
+        } else {
+            (0..super::BLOCK_CELLS)
+                .any(|i| region.contains(key.voxel(i)) && cell_class(b, i) == class)
+        }
+    };
+    if box_blocks <= allocated as u128 {
+        region.blocks().any(|key| match block(key) {
+            Some(b) => decide(key, b),
+            None => class == VoxelClass::Unknown,
+        })
+    } else {
+        blocks
+            .filter(|(key, _)| region.meets_block(*key))
+            .any(|(key, b)| decide(key, b))
     }
 }
 
