@@ -15,7 +15,8 @@
 //! - integration of [`PointCloud`]s (exact ray walk) and [`DepthFrame`]s with depth intervals
 //!   (projective frustum), into [`ScanEvidence`];
 //! - the [`depth`] stage: motion stereo from posed images to interval depth with confidence;
-//! - the dual-set [`FuzzyMap`] with its [`Measures`], merge, and crash-safe files.
+//! - the dual-set [`FuzzyMap`] with its [`Measures`], merge, and crash-safe files;
+//! - [`bag`]: robot recordings (ROS 1 bags, ROS 2 MCAP bags) as scans and posed frames.
 //!
 //! ```
 //! use fuzzyvox::{FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMap, VoxelMapMut};
@@ -32,6 +33,7 @@
 //! # Ok::<(), fuzzyvox::Error>(())
 //! ```
 
+pub use fuzzyvox_bag as bag;
 pub use fuzzyvox_core::{
     class, error, file, geometry, image, integrate, map, measures, ops, storage,
 };

@@ -19,6 +19,10 @@ use serde_json::json;
 /// then points in the sensor frame) and scan lists (`.list`, `CLOUD ox oy oz` per line: a text
 /// cloud in world coordinates, relative to the list's folder, and its sensor origin). Each
 /// graph or log node and each list line is one scan from its own origin.
+///
+/// Robot recordings (`--bag`: a ROS 1 `.bag`, an `.mcap` file or a ROS 2 bag folder): every
+/// `sensor_msgs/PointCloud2` on `--topic`, carried into `--frame` by the TF tree (`/tf`,
+/// `/tf_static`) at the cloud's stamp, is one scan from its sensor's origin.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
     fuzzyvox insert --cloud scan.dat --res 0.1 --out scan.fvx\n  \
@@ -26,12 +30,24 @@ use serde_json::json;
     fuzzyvox insert --cloud cloud.xyz --res 0.05 --origin 0,0,1.2 --max-range 20 --op dombi:2 --json\n  \
     fuzzyvox insert --cloud confident.xyz --res 0.1 --model alpha --cuts 10 --out alpha.fvx\n  \
     fuzzyvox insert --cloud new.xyz --res 0.08 --prior geb079.bt --prior-confidence 0.6 --out updated.fvx\n  \
-    fuzzyvox insert --cloud scans.list --res 0.05 --model logodds --json")]
+    fuzzyvox insert --cloud scans.list --res 0.05 --model logodds --json\n  \
+    fuzzyvox insert --bag recording.bag --topic /camera/depth/points --res 0.05 --out map.fvx\n  \
+    fuzzyvox insert --bag lidar.mcap --topic /points --frame lidar --res 0.2 --json")]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["cloud", "bag"])))]
 pub struct InsertArgs {
     /// Input scans: a text cloud, an OctoMap `.graph`, an OctoMap `.log` or a scan list
     /// (`.list`).
     #[arg(long)]
-    cloud: PathBuf,
+    cloud: Option<PathBuf>,
+    /// A robot recording: a ROS 1 `.bag`, an `.mcap` file or a ROS 2 bag folder.
+    #[arg(long, requires = "topic")]
+    bag: Option<PathBuf>,
+    /// The recording's `sensor_msgs/PointCloud2` topic.
+    #[arg(long, requires = "bag")]
+    topic: Option<String>,
+    /// The map's frame in the recording's TF tree (a cloud already in it needs no transform).
+    #[arg(long, default_value = "map", requires = "bag")]
+    frame: String,
     /// Voxel size in metres.
     #[arg(long, allow_negative_numbers = true)]
     res: f64,
@@ -85,14 +101,20 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
         .map_err(super::held_out::flag_error)?;
     let prior_voxels = args.prior.apply(&mut map)?;
     let reading = super::progress::spinner("reading the scans", args.json);
-    let scans = super::input::read_scans(&args.cloud, args.origin)?;
+    let input = super::input::read_input(
+        args.cloud.as_deref(),
+        args.origin,
+        args.bag.as_deref().zip(args.topic.as_deref()),
+        &args.frame,
+    )?;
+    let (scans, source) = (input.scans, input.source);
     reading.finish_and_clear();
-    tracing::info!("{} scan(s) read from {}", scans.len(), args.cloud.display());
+    tracing::info!("{} scan(s) read from {}", scans.len(), source.display());
     if args.model == MapKind::AlphaCut && scans.iter().any(|s| s.confidence().is_none()) {
         bail!(
             "the alpha model needs a confidence per point, and {} has none: give a text cloud \
              with `x y z confidence` lines (confidence in [0, 1]), or use --model logodds",
-            args.cloud.display()
+            source.display()
         );
     }
     let options = IntegrationOptions {
@@ -142,6 +164,7 @@ pub fn run(args: InsertArgs) -> anyhow::Result<()> {
         return super::print_json(&json!({
             "points": points,
             "scans": scans.len(),
+            "dropped_points": input.dropped_points,
             "integrated": total.integrated,
             "skipped": total.skipped,
             "clipped": total.clipped,

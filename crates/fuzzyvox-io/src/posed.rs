@@ -217,6 +217,54 @@ impl PosedFolder {
     }
 }
 
+/// Posed colour frames from any source, as the one-camera depth stage and its checks read
+/// them: a folder ([`PosedFolder`]) or a robot recording (`fuzzyvox-bag`'s `BagFrames`).
+pub trait PosedFrames: Sync {
+    /// Where the frames come from (a folder, a recording), for reports.
+    fn source(&self) -> &Path;
+    /// Where the colour camera's intrinsics come from (a file, or a recording's topic), for
+    /// reports.
+    fn intrinsics_source(&self) -> PathBuf;
+    /// Each frame's `world_from_camera` of the colour camera, in frame order.
+    fn poses(&self) -> &[Isometry3<f64>];
+    /// Frame `index` as the depth stage reads it: the grey image, the colour camera's
+    /// intrinsics and pose, and its time.
+    fn read_frame(&self, index: usize) -> Result<Frame>;
+    /// Frame `index`'s sensor depth with its noise model, or `None` when the source has none
+    /// for it (used to evaluate, never to map).
+    fn read_sensor_depth(&self, index: usize) -> Result<Option<DepthFrame>>;
+    /// The number of frames.
+    fn len(&self) -> usize {
+        self.poses().len()
+    }
+    /// Whether there is no frame.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl PosedFrames for PosedFolder {
+    fn source(&self) -> &Path {
+        &self.dir
+    }
+
+    fn intrinsics_source(&self) -> PathBuf {
+        self.color_intrinsics.clone()
+    }
+
+    fn poses(&self) -> &[Isometry3<f64>] {
+        &self.poses
+    }
+
+    fn read_frame(&self, index: usize) -> Result<Frame> {
+        PosedFolder::read_frame(self, index)
+    }
+
+    fn read_sensor_depth(&self, index: usize) -> Result<Option<DepthFrame>> {
+        PosedFolder::read_sensor_depth(self, index)
+    }
+}
+
 /// `frame-N.pose.txt` beside a `frame-N.color.*` file, keeping the number's own digits.
 fn pose_path(color: &Path) -> PathBuf {
     let name = color

@@ -7,7 +7,7 @@
 use fuzzyvox_core::error::{Error, Result};
 use fuzzyvox_core::integrate::IntegrationOptions;
 use fuzzyvox_core::map::{LogOddsConfig, LogOddsMap, VoxelMap, VoxelMapMut};
-use fuzzyvox_io::posed::PosedFolder;
+use fuzzyvox_io::posed::PosedFrames;
 use fuzzyvox_plan::{PlannerConfig, UnknownPolicy};
 use nalgebra::Point3;
 use serde::Serialize;
@@ -96,10 +96,13 @@ pub struct RealFlights {
 
 /// The reference map of `folder`: the sensor depth of every frame that has it, inserted into a
 /// log-odds map at `resolution` metres. `None` when no frame has sensor depth.
-pub(super) fn reference_map(folder: &PosedFolder, resolution: f64) -> Result<Option<LogOddsMap>> {
+pub(super) fn reference_map(
+    folder: &dyn PosedFrames,
+    resolution: f64,
+) -> Result<Option<LogOddsMap>> {
     let mut reference = LogOddsMap::new(LogOddsConfig::new(resolution)?)?;
     let mut any = false;
-    for position in 0..folder.frames.len() {
+    for position in 0..folder.len() {
         if let Some(sensor) = folder.read_sensor_depth(position)? {
             reference.integrate_depth(&sensor, &IntegrationOptions::default())?;
             any = true;

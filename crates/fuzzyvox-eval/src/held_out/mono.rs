@@ -19,7 +19,7 @@ use fuzzyvox_core::integrate::DepthFrame;
 use fuzzyvox_core::integrate::IntegrationOptions;
 use fuzzyvox_core::map::VoxelMap;
 use fuzzyvox_depth::{ConsistencyFilter, ConsistencyParams};
-use fuzzyvox_io::posed::PosedFolder;
+use fuzzyvox_io::posed::{PosedFolder, PosedFrames};
 use fuzzyvox_io::rgbd::read_pose_txt;
 
 /// The depth stage's own depth against the sensor's, with its share of the time.
@@ -128,13 +128,13 @@ pub fn run_mono(
 /// `progress(stage, done, total)` is called with `done = 0` when a stage starts and after each
 /// frame.
 pub fn run_mono_on(
-    folder: &PosedFolder,
+    folder: &dyn PosedFrames,
     config: &MonoConfig,
     progress: &mut dyn FnMut(HeldOutStage, usize, usize),
 ) -> Result<MonoRun> {
     config.validate()?;
     let held_out = &config.held_out;
-    let split = HoldoutSplit::new(folder.frames.len(), held_out.holdout)?;
+    let split = HoldoutSplit::new(folder.len(), held_out.holdout)?;
     let mut stream = config.stream()?;
     let check = held_out.check();
     let mut maps: Vec<MapUnderTest> = held_out
@@ -213,10 +213,10 @@ pub fn run_mono_on(
             progress(HeldOutStage::Flights, 0, 1);
             let t = Instant::now();
             let reference = reference_map(folder, held_out.resolution)?.ok_or(Error::Empty(
-                "sensor depth in the folder (flights are checked against a map of it)",
+                "sensor depth in the frames (flights are checked against a map of it)",
             ))?;
             let cameras: Vec<_> = folder
-                .poses
+                .poses()
                 .iter()
                 .map(|p| p.translation.vector.into())
                 .collect();
@@ -232,8 +232,8 @@ pub fn run_mono_on(
     let mapping = (seconds.read + seconds.depth + seconds.integrate).max(1e-9);
     let report = MonoReport {
         split: FolderSplit::new(
-            &folder.dir,
-            folder.frames.len(),
+            folder.source(),
+            folder.len(),
             &split,
             held_out.holdout,
             held_out.resolution,
@@ -241,7 +241,7 @@ pub fn run_mono_on(
         held_out_checked: checked,
         views: config.views,
         depth_range: [config.near, config.far],
-        color_intrinsics: folder.color_intrinsics.clone(),
+        color_intrinsics: folder.intrinsics_source(),
         depth_images: counts.depth_images(),
         rectified: counts.rectified,
         swept: counts.swept,
@@ -284,7 +284,7 @@ pub fn run_mono_on(
 /// Measures checked depth images (each with its frame's position in the folder) against their
 /// frames' sensor depth, where there is some, and integrates them into every map.
 fn add_checked(
-    folder: &PosedFolder,
+    folder: &dyn PosedFrames,
     checked: Vec<(usize, DepthFrame)>,
     maps: &mut [MapUnderTest],
     stage: &mut DepthStageErrors,
