@@ -68,6 +68,7 @@ impl BagFrames {
         let mut tree = TfTree::new();
         let mut images: Vec<(Header, usize, Pixels)> = Vec::new();
         let mut infos: Vec<(String, CameraInfo)> = Vec::new();
+        let mut info_topics: Vec<String> = Vec::new();
         let mut tf_index = 0;
         bag.for_each_message(&mut |m| {
             if add_tf(&mut tree, &m, tf_index)? {
@@ -97,11 +98,14 @@ impl BagFrames {
                     });
                 };
                 images.push((header, index, pixels));
-            } else if CameraInfo::is_type(&c.msg_type)
-                && info_topic.is_none_or(|wanted| wanted == c.topic)
-            {
-                let at = infos.iter().filter(|(t, _)| *t == c.topic).count();
-                infos.push((c.topic.clone(), CameraInfo::decode(&m, at)?));
+            } else if CameraInfo::is_type(&c.msg_type) {
+                if !info_topics.contains(&c.topic) {
+                    info_topics.push(c.topic.clone());
+                }
+                if info_topic.is_none_or(|wanted| wanted == c.topic) {
+                    let at = infos.iter().filter(|(t, _)| *t == c.topic).count();
+                    infos.push((c.topic.clone(), CameraInfo::decode(&m, at)?));
+                }
             }
             Ok(())
         })?;
@@ -115,7 +119,8 @@ impl BagFrames {
                 available,
             });
         }
-        let info_topic = choose_info_topic(image_topic, info_topic, &infos)?;
+        info_topics.sort();
+        let info_topic = choose_info_topic(image_topic, info_topic, &info_topics)?;
         let intrinsics = intrinsics_of(bag.path(), &info_topic, &infos)?;
         images.sort_by_key(|(header, index, _)| (header.stamp_ns, *index));
         let first = images.first().map_or(0, |(h, _, _)| h.stamp_ns);
@@ -157,18 +162,11 @@ impl BagFrames {
 
 /// The camera-info topic for `image_topic`: the one asked for, else `camera_info` beside the
 /// images (under the image topic's parents, nearest first), else the only one there is.
-fn choose_info_topic(
-    image_topic: &str,
-    asked: Option<&str>,
-    infos: &[(String, CameraInfo)],
-) -> Result<String> {
-    let mut topics: Vec<String> = infos.iter().map(|(t, _)| t.clone()).collect();
-    topics.sort();
-    topics.dedup();
+fn choose_info_topic(image_topic: &str, asked: Option<&str>, topics: &[String]) -> Result<String> {
     let missing = |topic: &str| BagError::UnknownTopic {
         topic: topic.to_string(),
         kind: "camera info",
-        available: topics.clone(),
+        available: topics.to_vec(),
     };
     if let Some(asked) = asked {
         return if topics.iter().any(|t| t == asked) {
@@ -185,7 +183,7 @@ fn choose_info_topic(
         }
         prefix = parent;
     }
-    match topics.as_slice() {
+    match topics {
         [only] => Ok(only.clone()),
         _ => {
             let (parent, _) = image_topic.rsplit_once('/').unwrap_or_default();

@@ -2,11 +2,12 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use fuzzyvox::bag::{Bag, BagFrames};
 use fuzzyvox::depth::ConsistencyParams;
 use fuzzyvox::eval::{
     HeldOutConfig, MapCheckReport, MonoConfig, RealFlightConfig, run_mono_on, write_held_out_maps,
 };
-use fuzzyvox::io::posed::PosedFolder;
+use fuzzyvox::io::posed::{PosedFolder, PosedFrames};
 use fuzzyvox::io::rgbd::read_pose_txt;
 use tracing::info;
 
@@ -36,16 +37,37 @@ use super::held_out::{MapCheckArgs, StageBars, flag_error, print_table};
 /// depth stage (the median relative error of `P0` and how often the sensor's depth lies inside
 /// `[P-, P+]`, over all pixels and the most confident half) and checks the maps against the
 /// held-out frames (`within_2_voxels`, as `rgbd` does).
+///
+/// A robot recording works too (`--bag`: a ROS 1 `.bag`, an `.mcap` file or a ROS 2 bag
+/// folder): the colour images of `--image-topic` (`sensor_msgs/CompressedImage` or `Image`), the
+/// intrinsics of the `sensor_msgs/CameraInfo` beside them (`--info-topic` to choose another),
+/// each image posed in `--frame` by the TF tree at its stamp. Recordings carry no sensor depth
+/// for the checks, so only the maps and the depth stage's counts are reported.
 #[derive(Args)]
 #[command(after_help = "Examples:\n  \
     fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04\n  \
     fuzzyvox mono --dir ../shared/data/rgbd-7scenes-redkitchen --res 0.04 --views 2 --consistency 0 --json\n  \
     fuzzyvox mono --dir DIR --res 0.05 --trajectory poses.tum --model fuzzy --out maps/\n  \
-    fuzzyvox mono --dir ../shared/data/rgbd-hololens-000 --res 0.05 --plan 50 --json")]
+    fuzzyvox mono --dir ../shared/data/rgbd-hololens-000 --res 0.05 --plan 50 --json\n  \
+    fuzzyvox mono --bag ../shared/data/robot-logs/hololens-000-mcap --image-topic /camera/color/image_raw/compressed --res 0.05 --out maps/")]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["dir", "bag"])))]
 pub struct MonoArgs {
     /// The folder of posed colour frames.
     #[arg(long)]
-    dir: PathBuf,
+    dir: Option<PathBuf>,
+    /// A robot recording instead of a folder.
+    #[arg(long, requires = "image_topic", conflicts_with_all = ["trajectory", "extrinsics"])]
+    bag: Option<PathBuf>,
+    /// The recording's colour images (`sensor_msgs/CompressedImage` or `sensor_msgs/Image`).
+    #[arg(long, requires = "bag")]
+    image_topic: Option<String>,
+    /// The recording's `sensor_msgs/CameraInfo` topic (default: `camera_info` beside the
+    /// images, or the only one).
+    #[arg(long, requires = "bag")]
+    info_topic: Option<String>,
+    /// The world frame of the recording's TF tree.
+    #[arg(long, default_value = "map", requires = "bag")]
+    frame: String,
     #[command(flatten)]
     maps: MapCheckArgs,
     /// Views matched at once for each depth image (2: pairs).
@@ -129,35 +151,21 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
         }),
     };
     config.validate().map_err(flag_error)?;
-    let extrinsics = match &args.extrinsics {
-        Some(path) => Some(
-            read_pose_txt(path)
-                .with_context(|| format!("reading the extrinsics {}", path.display()))?,
-        ),
-        None => None,
-    };
-    let folder = PosedFolder::open(&args.dir, args.trajectory.as_deref(), extrinsics)
-        .with_context(|| format!("opening the image folder {}", args.dir.display()))?;
-    info!(
-        "{} frames in {} ({})",
-        folder.frames.len(),
-        args.dir.display(),
-        folder.color_intrinsics.display(),
-    );
+    let (frames, source) = open_frames(&args)?;
     let mut bars = StageBars::new(args.json);
-    let run = run_mono_on(&folder, &config, &mut |stage, done, total| {
+    let run = run_mono_on(frames.as_ref(), &config, &mut |stage, done, total| {
         bars.update(stage, done, total)
     })
     .map_err(flag_error)
-    .with_context(|| format!("mapping {}", args.dir.display()))?;
+    .with_context(|| format!("mapping {}", source.display()))?;
     bars.finish();
     if let Some(dir) = &args.out {
-        let cameras: Vec<_> = folder
-            .poses
+        let cameras: Vec<_> = frames
+            .poses()
             .iter()
             .map(|p| p.translation.vector.into())
             .collect();
-        let title = args.dir.file_name().unwrap_or_default().to_string_lossy();
+        let title = source.file_name().unwrap_or_default().to_string_lossy();
         for file in write_held_out_maps(dir, &title, &run.maps, &cameras)
             .with_context(|| format!("writing the maps into {}", dir.display()))?
         {
@@ -171,7 +179,7 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
     println!(
         "{}: {} frames; {} build the maps ({} depth images: {} rectified, {} swept, {} multi-view; \
          {} without), {} held out ({} with sensor depth)",
-        args.dir.display(),
+        source.display(),
         report.split.frames,
         report.split.build_frames,
         report.depth_images,
@@ -215,6 +223,37 @@ pub fn run(args: MonoArgs) -> anyhow::Result<()> {
     print_table(&report.maps);
     print_flights(&report.maps);
     Ok(())
+}
+
+/// The posed frames of the folder or of the recording, and its path.
+fn open_frames(args: &MonoArgs) -> anyhow::Result<(Box<dyn PosedFrames>, PathBuf)> {
+    if let (Some(bag), Some(topic)) = (&args.bag, &args.image_topic) {
+        let reading = || format!("reading {}", bag.display());
+        let recording = Bag::open(bag).with_context(reading)?;
+        let frames = BagFrames::open(&recording, topic, args.info_topic.as_deref(), &args.frame)
+            .with_context(reading)?;
+        info!("{} frames on {topic} in {}", frames.len(), bag.display());
+        return Ok((Box::new(frames), bag.clone()));
+    }
+    let Some(dir) = &args.dir else {
+        anyhow::bail!("give --dir or --bag with --image-topic");
+    };
+    let extrinsics = match &args.extrinsics {
+        Some(path) => Some(
+            read_pose_txt(path)
+                .with_context(|| format!("reading the extrinsics {}", path.display()))?,
+        ),
+        None => None,
+    };
+    let folder = PosedFolder::open(dir, args.trajectory.as_deref(), extrinsics)
+        .with_context(|| format!("opening the image folder {}", dir.display()))?;
+    info!(
+        "{} frames in {} ({})",
+        folder.frames.len(),
+        dir.display(),
+        folder.color_intrinsics.display(),
+    );
+    Ok((Box::new(folder), dir.clone()))
 }
 
 /// The flights of every map, when there were any.

@@ -52,6 +52,11 @@ impl Ros1Bag {
             )));
         }
         let bag = RosBag::new(path).map_err(|e| damaged(e.to_string()))?;
+        // The index section (connections, chunk infos) must read whole too: a cut there means a
+        // damaged copy even when the chunks before it survived.
+        for record in bag.index_records() {
+            record.map_err(|e| damaged(format!("index section: {e}")))?;
+        }
         Ok(Self {
             path: path.to_path_buf(),
             bag,
