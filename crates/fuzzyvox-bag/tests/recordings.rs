@@ -46,6 +46,9 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// A topic, its type and its message count.
+type Topic = (&'static str, &'static str, usize);
+
 /// Topics, types and counts as the rosbags library (0.11.9) lists them for each recording
 /// (`scripts/check-bags` compares the two on every run; ROS 1 types as the bag spells them).
 #[test]
@@ -53,7 +56,7 @@ fn info_lists_what_the_rosbags_library_lists() {
     let Some(data) = data_dir("info_lists_what_the_rosbags_library_lists") else {
         return;
     };
-    let expected: [(&str, &str, &[(&str, &str, usize)]); 4] = [
+    let expected: [(&str, &str, &[Topic]); 4] = [
         (
             "hololens-000-mcap",
             "ros2",
