@@ -356,3 +356,76 @@ fn damaged_recordings_are_errors() {
     .unwrap();
     assert!(matches!(Bag::open(&folder), Err(BagError::Damaged { .. })));
 }
+
+/// The HoloLens recording rewritten with zstd and with lz4 chunks (the shared file's chunks
+/// are uncompressed) reads as the original; a damaged compressed chunk is an error.
+#[test]
+fn compressed_chunks_read_as_plain_ones() {
+    let Some(data) = data_dir("compressed_chunks_read_as_plain_ones") else {
+        return;
+    };
+    let original = open(&data, "hololens-000-mcap");
+    let expected = read_bag_scans(&original, POINTS, "map").unwrap();
+    let mut messages = Vec::new();
+    original
+        .for_each_message(&mut |m| {
+            let c = m.connection;
+            messages.push((
+                c.topic.clone(),
+                c.msg_type.clone(),
+                m.log_time,
+                m.data.to_vec(),
+            ));
+            Ok(())
+        })
+        .unwrap();
+    for compression in [mcap::Compression::Zstd, mcap::Compression::Lz4] {
+        let options = mcap::WriteOptions::new()
+            .compression(Some(compression))
+            .chunk_size(Some(1 << 20));
+        let mut writer = options.create(std::io::Cursor::new(Vec::new())).unwrap();
+        let mut channels = std::collections::BTreeMap::new();
+        for (sequence, (topic, msg_type, log_time, bytes)) in messages.iter().enumerate() {
+            let channel_id = match channels.get(topic) {
+                Some(&id) => id,
+                None => {
+                    let schema = writer.add_schema(msg_type, "ros2msg", b"").unwrap();
+                    let id = writer
+                        .add_channel(schema, topic, "cdr", &Default::default())
+                        .unwrap();
+                    channels.insert(topic.clone(), id);
+                    id
+                }
+            };
+            let header = mcap::records::MessageHeader {
+                channel_id,
+                sequence: sequence as u32,
+                log_time: *log_time,
+                publish_time: *log_time,
+            };
+            writer.write_to_known_channel(&header, bytes).unwrap();
+        }
+        writer.finish().unwrap();
+        let bytes = writer.into_inner().into_inner();
+        let plain =
+            std::fs::metadata(data.join("robot-logs/hololens-000-mcap/hololens-000-mcap.mcap"))
+                .unwrap()
+                .len();
+        assert!(
+            (bytes.len() as u64) < plain,
+            "{compression:?} did not compress"
+        );
+        let bag = Bag::from_mcap_bytes(Path::new("compressed.mcap"), bytes.clone()).unwrap();
+        let scans = read_bag_scans(&bag, POINTS, "map").unwrap();
+        assert_eq!(scans.scans, expected.scans, "{compression:?}");
+        let mut damaged = bytes;
+        let middle = damaged.len() / 2;
+        damaged[middle..middle + 16].fill(0);
+        let read = Bag::from_mcap_bytes(Path::new("damaged.mcap"), damaged)
+            .and_then(|bag| read_bag_scans(&bag, POINTS, "map"));
+        assert!(
+            matches!(read, Err(BagError::Damaged { .. })),
+            "{compression:?}: {read:?}"
+        );
+    }
+}
