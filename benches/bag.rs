@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use criterion::{Criterion, criterion_group, criterion_main};
 use fuzzyvox::bag::{Bag, read_bag_scans};
 use fuzzyvox::io::read_scan_list;
-use fuzzyvox::{IntegrationOptions, LogOddsConfig, LogOddsMap, PointCloud, VoxelMap, VoxelMapMut};
+use fuzzyvox::{IntegrationOptions, LogOddsConfig, LogOddsMap, PointCloud, VoxelMapMut};
 
 const TOPIC: &str = "/camera/depth/points";
 
