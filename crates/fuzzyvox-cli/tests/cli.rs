@@ -551,6 +551,20 @@ fn printed_plan_examples_work() {
         map.to_str().unwrap(),
         "--json",
     ]));
+    // The README's map of a robot recording, made as it says.
+    let room = dir.join("room.fvx");
+    json(&fuzzyvox(&[
+        "insert",
+        "--bag",
+        data.join("robot-logs/hololens-000.bag").to_str().unwrap(),
+        "--topic",
+        "/camera/depth/points",
+        "--res",
+        "0.05",
+        "--out",
+        room.to_str().unwrap(),
+        "--json",
+    ]));
     let root = common::repo_root();
     let mut examples = Vec::new();
     for doc in ["README.md", "docs/planning.md", "docs/cli.md"] {
@@ -570,6 +584,7 @@ fn printed_plan_examples_work() {
             .skip(1)
             .map(|a| match a {
                 "scan.fvx" => map.to_str().unwrap().to_string(),
+                "room.fvx" => room.to_str().unwrap().to_string(),
                 // OctoMap's own map, wherever the data folder is.
                 other if other.ends_with("octomap-samples/geb079.bt") => data
                     .join("octomap-samples/geb079.bt")
