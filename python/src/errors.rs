@@ -19,6 +19,11 @@ fn raise(py: Python<'_>, class: &str, message: String) -> PyErr {
     }
 }
 
+/// An instance of `fuzzyvox._errors.<class>` carrying `message`, as a `PyErr`.
+pub fn raise_class(class: &str, message: String) -> PyErr {
+    Python::attach(|py| raise(py, class, message))
+}
+
 /// Bad input: `fuzzyvox.InvalidInputError`, a `ValueError`.
 pub fn invalid(message: impl Into<String>) -> PyErr {
     Python::attach(|py| raise(py, "InvalidInputError", message.into()))

@@ -9,6 +9,7 @@
 //! Rust message.
 
 mod arrays;
+mod bag;
 mod errors;
 mod held_out;
 mod maps;
@@ -165,6 +166,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(operators, m)?)?;
     m.add_function(wrap_pyfunction!(parse_operator, m)?)?;
     m.add_function(wrap_pyfunction!(read_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(bag::bag_info, m)?)?;
+    m.add_function(wrap_pyfunction!(bag::read_bag, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::run_experiment, m)?)?;
     m.add_function(wrap_pyfunction!(held_out::rgbd, m)?)?;

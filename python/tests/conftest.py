@@ -47,3 +47,8 @@ def room_cloud(seed: int = 0, n: int = 4000) -> np.ndarray:
     pts[face == 4, 2] = -1
     pts[face == 5, 2] = 2
     return pts
+
+
+@pytest.fixture
+def hololens_bag() -> Path:
+    return data_file("robot-logs/hololens-000.bag")

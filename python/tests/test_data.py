@@ -1,8 +1,10 @@
-"""OctoMap's scan.dat through the package (needs FUZZYVOX_DATA)."""
+"""Real data through the package: OctoMap's scan.dat, RGB-D frames and a robot recording (needs
+FUZZYVOX_DATA)."""
 
 import pickle
 
 import numpy as np
+import pytest
 
 import fuzzyvox
 
@@ -63,3 +65,30 @@ def test_rgbd_frames_merge_as_serial(rgbd_dir):
     assert len(halves[0].voxels()[0]) == len(centres)
     assert np.abs(halves[0].memberships(centres) - mu).max() < 1e-5
     assert np.array_equal(halves[0].classes(centres), serial.classes(centres))
+
+
+def test_robot_recording(hololens_bag, tmp_path):
+    info = fuzzyvox.bag_info(hololens_bag)
+    assert info["format"] == "ros1"
+    assert [(t["name"], t["type"], t["count"]) for t in info["topics"]] == [
+        ("/camera/depth/points", "sensor_msgs/PointCloud2", 80),
+        ("/tf", "tf2_msgs/TFMessage", 80),
+    ]
+    assert info["tf"][0]["parent"] == "map"
+    scans = fuzzyvox.read_bag(hololens_bag, "/camera/depth/points")
+    assert len(scans) == 80
+    assert sum(len(points) for points, _ in scans) == 1_138_584
+    # The same map as `fuzzyvox insert --bag`: OctoMap's counts for these clouds and origins.
+    m = fuzzyvox.LogOddsMap(0.05)
+    for points, origin in scans:
+        m.integrate_cloud(points, origin=origin)
+    counts = m.counts()
+    assert (counts["occupied"], counts["free"]) == (28_011, 351_202)
+    with pytest.raises(fuzzyvox.InvalidInputError, match="point cloud topics: /camera/depth/points"):
+        fuzzyvox.read_bag(hololens_bag, "/points")
+    with pytest.raises(fuzzyvox.InvalidInputError, match="no transform from"):
+        fuzzyvox.read_bag(hololens_bag, "/camera/depth/points", frame="world")
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(hololens_bag.read_bytes()[:100_000])
+    with pytest.raises(fuzzyvox.MapFileError, match="damaged recording"):
+        fuzzyvox.bag_info(cut)
