@@ -14,7 +14,7 @@ use fuzzyvox_io::decode_gray_image;
 use fuzzyvox_io::posed::PosedFrames;
 
 use crate::error::{BagError, Result};
-use crate::messages::{CameraInfo, CompressedImage, Header, Image, Message, frame_name};
+use crate::messages::{CameraInfo, CompressedImage, Header, Image, Message};
 use crate::reader::Bag;
 use crate::scans::{add_tf, topics_of};
 use crate::tf::TfTree;
@@ -124,19 +124,10 @@ impl BagFrames {
         let intrinsics = intrinsics_of(bag.path(), &info_topic, &infos)?;
         images.sort_by_key(|(header, index, _)| (header.stamp_ns, *index));
         let first = images.first().map_or(0, |(h, _, _)| h.stamp_ns);
-        let frame = frame_name(frame);
         let mut poses = Vec::with_capacity(images.len());
         let mut times = Vec::with_capacity(images.len());
         for (header, _, _) in &images {
-            let pose = tree
-                .lookup(&frame, &header.frame_id, header.stamp_ns)
-                .map_err(|detail| BagError::NoTransform {
-                    source_frame: header.frame_id.clone(),
-                    target_frame: frame.clone(),
-                    stamp: header.stamp_seconds(),
-                    detail,
-                })?;
-            poses.push(pose);
+            poses.push(tree.pose_of(frame, header)?);
             times.push((header.stamp_ns - first) as f64 * 1e-9);
         }
         Ok(Self {

@@ -96,7 +96,6 @@ pub fn read_bag_scans(bag: &Bag, topic: &str, frame: &str) -> Result<BagScans> {
         });
     }
     clouds.sort_by_key(|(_, index, cloud)| (cloud.header.stamp_ns, *index));
-    let frame = crate::messages::frame_name(frame);
     let decoded: Vec<(PointCloud, f64, usize)> = clouds
         .par_iter()
         .map(|(_, index, cloud)| {
@@ -107,14 +106,7 @@ pub fn read_bag_scans(bag: &Bag, topic: &str, frame: &str) -> Result<BagScans> {
                 detail,
             })?;
             let header = &cloud.header;
-            let world_from_sensor = tree
-                .lookup(&frame, &header.frame_id, header.stamp_ns)
-                .map_err(|detail| BagError::NoTransform {
-                    source_frame: header.frame_id.clone(),
-                    target_frame: frame.clone(),
-                    stamp: header.stamp_seconds(),
-                    detail,
-                })?;
+            let world_from_sensor = tree.pose_of(frame, header)?;
             let world: Vec<Point3<f64>> = points
                 .points
                 .iter()

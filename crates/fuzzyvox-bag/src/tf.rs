@@ -9,7 +9,8 @@ use std::collections::BTreeMap;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use serde::Serialize;
 
-use crate::messages::{TransformStamped, frame_name};
+use crate::error::BagError;
+use crate::messages::{Header, TransformStamped, frame_name};
 
 /// Chains longer than this are taken for a loop.
 const MAX_DEPTH: usize = 1000;
@@ -148,6 +149,18 @@ impl TfTree {
         Ok(ancestor_from_target.inverse() * ancestor_from_source)
     }
 
+    /// The pose in `frame` of the data stamped by `header` (its frame at its stamp), or
+    /// [`BagError::NoTransform`] naming both frames, the stamp and why.
+    pub fn pose_of(&self, frame: &str, header: &Header) -> crate::Result<Isometry3<f64>> {
+        self.lookup(frame, &header.frame_id, header.stamp_ns)
+            .map_err(|detail| BagError::NoTransform {
+                source_frame: header.frame_id.clone(),
+                target_frame: frame_name(frame),
+                stamp: header.stamp_seconds(),
+                detail,
+            })
+    }
+
     /// `frame`, its parent, its parent's parent, ... up to the root.
     fn chain(&self, frame: &str) -> Result<Vec<String>, String> {
         let mut chain = vec![frame.to_string()];
@@ -230,7 +243,7 @@ impl Edge {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::messages::{Header, Quaternion as Q, Transform, Vector3};
+    use crate::messages::{Quaternion as Q, Transform, Vector3};
     use nalgebra::{Point3, Vector3 as V};
 
     fn t(parent: &str, child: &str, ns: i64, xyz: [f64; 3], yaw: f64) -> TransformStamped {
