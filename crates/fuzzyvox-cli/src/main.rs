@@ -1,6 +1,9 @@
 //! The `fuzzyvox` command: argument parsing and output formatting over the library (the
 //! `fuzzyvox` facade crate). Each command lives in its own file; the work is the library's.
 
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 mod demo;
 mod eval;
 mod export;

@@ -69,7 +69,11 @@ const PLANES: [std::ops::Range<usize>; 4] = [0..7, 7..15, 15..23, 23..31];
 /// strings stay in SIMD registers while the 31 neighbours are compared, each comparison
 /// filling one bit of sixteen byte lanes. The last block overlaps the one before when the row
 /// is not a whole number of blocks (recomputing a string is harmless). Rows narrower than a
-/// block use the clamped loop.
+/// block use the clamped loop. Compiled for AVX-512 and AVX2 as well, chosen at run time.
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
+    "x86_64+avx2+popcnt",
+))]
 fn interior_codes(
     rows: &[&[f32]; CENSUS_HEIGHT],
     centre: &[f32],

@@ -4,20 +4,6 @@
 use super::context::{Band, CODE_BYTES, Context, LANES, full_columns, valid_range};
 use crate::census::{CENSUS_MAX_COST, CensusCode};
 
-/// Population count of each byte's nibbles, branch-free in byte lanes (SSE2 has no byte
-/// popcount); two of these add without overflow (at most 8 per nibble).
-#[inline(always)]
-fn nibble_counts(v: u8) -> u8 {
-    let v = v - ((v >> 1) & 0x55);
-    (v & 0x33) + ((v >> 2) & 0x33)
-}
-
-/// The byte total of two added [`nibble_counts`] (at most 16).
-#[inline(always)]
-fn byte_total(v: u8) -> u8 {
-    (v & 0x0f) + (v >> 4)
-}
-
 /// Census Hamming costs of `LANES` disparities: the left string's bytes `code` against `LANES`
 /// consecutive entries of the four reversed right planes. Sixteen disparities per SSE
 /// instruction.
@@ -28,9 +14,11 @@ fn chunk_costs(code: [u8; CODE_BYTES], q: [&[u8]; CODE_BYTES]) -> [u8; LANES] {
     let (q0, q1, q2, q3) = (&q0[..LANES], &q1[..LANES], &q2[..LANES], &q3[..LANES]);
     let mut costs = [0u8; LANES];
     for k in 0..LANES {
-        let low = nibble_counts(b0 ^ q0[k]) + nibble_counts(b1 ^ q1[k]);
-        let high = nibble_counts(b2 ^ q2[k]) + nibble_counts(b3 ^ q3[k]);
-        costs[k] = byte_total(low) + byte_total(high);
+        let bits = (b0 ^ q0[k]).count_ones()
+            + (b1 ^ q1[k]).count_ones()
+            + (b2 ^ q2[k]).count_ones()
+            + (b3 ^ q3[k]).count_ones();
+        costs[k] = bits as u8;
     }
     costs
 }
@@ -158,7 +146,10 @@ pub(super) fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize)
 /// Costs and enters consecutive columns whose disparities are all searchable: column `i` (of
 /// `codes`, `old` and `vertical`, `stride` lanes each) reads the planes from `start - i`.
 /// (Not inlined: on its own, the compiler knows that the slices do not overlap.)
-#[inline(never)]
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
+    "x86_64+avx2+popcnt",
+))]
 fn enter_full_columns(
     codes: &[CensusCode],
     planes: [&[u8]; CODE_BYTES],

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 
 use crate::census::{CENSUS_MAX_COST, CensusImage, census_transform};
 use crate::params::{DisparityMap, MatchParams};
-use crate::texture::drop_textureless;
+use crate::texture::textureless;
 use fuzzyvox_core::image::GrayImage;
 
 mod context;
@@ -51,11 +51,16 @@ pub fn match_pair(
             found: right.pixels().len(),
         });
     }
-    let left_census = census_transform(left);
-    let right_census = census_transform(right);
-    let mut map = match_census(&left_census, &right_census, params);
-    drop_textureless(left, params, &mut map);
-    Ok(map)
+    let (flat, (mut left_census, right_census)) = rayon::join(
+        || textureless(left, params),
+        || rayon::join(|| census_transform(left), || census_transform(right)),
+    );
+    // Texture-less pixels are left out like pixels without a value: their decision affects no
+    // other pixel's, so this equals matching them and dropping them afterwards.
+    for (valid, flat) in left_census.valid.iter_mut().zip(flat) {
+        *valid &= !flat;
+    }
+    Ok(match_census(&left_census, &right_census, params))
 }
 
 /// Matches two census images of equal size (checked by [`match_pair`]).

@@ -177,7 +177,10 @@ fn horizontal_row(
 /// One column of the running sum, `column = previous + add - sub`, sixteen lanes at a time.
 /// (Not inlined: inlined, the compiler loses track of `column` and `previous` being apart
 /// and compiles it one lane at a time.)
-#[inline(never)]
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
+    "x86_64+avx2+popcnt",
+))]
 fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) -> i16 {
     let mut least = [i16::MAX; LANES];
     let steps = column
