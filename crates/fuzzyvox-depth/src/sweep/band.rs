@@ -79,6 +79,7 @@ impl Sweep {
 /// halo), `out` the aggregated rows `y0 .. y0 + out.len() / width`. Windows are clipped at the
 /// image border, which keeps each pixel's window the same on every plane.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn aggregate(
     raw: &[u8],
     first: usize,
@@ -90,21 +91,22 @@ fn aggregate(
     out: &mut [u16],
 ) {
     let (rx, ry) = radius;
-    let rows = raw.len() / width;
-    for r in 0..rows {
-        let src = &raw[r * width..(r + 1) * width];
-        let dst = &mut horizontal[r * width..(r + 1) * width];
-        let mut sum: u16 = src[..(rx + 1).min(width)]
-            .iter()
-            .map(|&c| u16::from(c))
-            .sum();
-        for x in 0..width {
-            dst[x] = sum;
-            if x + rx + 1 < width {
-                sum += u16::from(src[x + rx + 1]);
+    // Horizontal sums as the window's shifted rows added up (clipped at the row's ends): no
+    // running sum, so no chain from one column to the next, and every addition vectorises.
+    for (src, dst) in raw
+        .chunks_exact(width)
+        .zip(horizontal.chunks_exact_mut(width))
+    {
+        dst.fill(0);
+        for offset in 0..=rx.min(width - 1) {
+            // Column x adds src[x + offset] and src[x - offset].
+            for (d, &c) in dst.iter_mut().zip(&src[offset..]) {
+                *d += u16::from(c);
             }
-            if x >= rx {
-                sum -= u16::from(src[x - rx]);
+            if offset > 0 {
+                for (d, &c) in dst[offset..].iter_mut().zip(src) {
+                    *d += u16::from(c);
+                }
             }
         }
     }
@@ -150,6 +152,12 @@ fn aggregate(
 }
 
 /// Sweeps one band of rows `y0 .. y1` through every plane, twice, and returns its pixels' state.
+/// Compiled for AVX-512 and AVX2 as well (with the raw costs and the box sums inlined), chosen
+/// at run time.
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
+    "x86_64+avx2+popcnt",
+))]
 pub(super) fn sweep_band(
     sweep: &Sweep,
     reference: &TaggedImage,
@@ -190,45 +198,81 @@ pub(super) fn sweep_band(
             costs,
         );
     }
-    let mut previous = vec![u16::MAX; n];
     let mut state = vec![PixelState::default(); n];
     for (r, row) in state.chunks_exact_mut(width).enumerate() {
         sweep.exclusions(rays.row(y0 - first + r), row);
     }
+    // The two passes run on one array per field, with selects instead of branches, so that
+    // they vectorise; the states are assembled at the end.
+    let exclusion: Vec<u32> = state.iter().map(|s| s.exclusion).collect();
+    let (mut best, mut best_plane, mut run_end) = (vec![u16::MAX; n], vec![0u32; n], vec![0u32; n]);
+    let (mut left, mut right) = (vec![u16::MAX; n], vec![u16::MAX; n]);
     // Pass 1: the best run of planes and the costs on either side of it.
+    let mut previous = vec![u16::MAX; n];
     for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
-        for ((s, &c), &p) in state.iter_mut().zip(costs).zip(&previous) {
-            if c < s.best {
-                (s.best, s.best_plane, s.run_end, s.left, s.right) = (c, k, k, p, u16::MAX);
-            } else if k == s.run_end + 1 && s.best != u16::MAX {
-                if c == s.best && s.right == u16::MAX && s.exclusion > 1 {
-                    s.run_end = k;
-                } else if s.right == u16::MAX {
-                    s.right = c;
-                }
-            }
+        let lanes = best
+            .iter_mut()
+            .zip(best_plane.iter_mut())
+            .zip(run_end.iter_mut())
+            .zip(left.iter_mut())
+            .zip(right.iter_mut())
+            .zip(exclusion.iter())
+            .zip(costs.iter().zip(previous.iter()));
+        for ((((((best, best_plane), run_end), left), right), &exclusion), (&c, &p)) in lanes {
+            // A new best starts a run; the plane right after the run either extends it (an
+            // equal cost, when a plane is less than a pixel of motion) or gives its right-hand
+            // cost.
+            let new_best = c < *best;
+            let next = !new_best && k == *run_end + 1 && *best != u16::MAX && *right == u16::MAX;
+            let extend = next && c == *best && exclusion > 1;
+            *right = if new_best {
+                u16::MAX
+            } else if next && !extend {
+                c
+            } else {
+                *right
+            };
+            *run_end = if new_best || extend { k } else { *run_end };
+            *best_plane = if new_best { k } else { *best_plane };
+            *left = if new_best { p } else { *left };
+            *best = if new_best { c } else { *best };
         }
         previous.copy_from_slice(costs);
     }
     // Pass 2: the best cost more than one pixel of motion beyond the run, and the cost-curve
     // range.
     let tolerance = 1.0 + f64::from(params.range_tolerance);
-    let limits: Vec<u16> = state
+    let limits: Vec<u16> = best
         .iter()
-        .map(|s| (f64::from(s.best) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
+        .map(|&b| (f64::from(b) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
         .collect();
+    let (mut runner_up, mut low, mut high) = (vec![u16::MAX; n], vec![u32::MAX; n], vec![0u32; n]);
     for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
-        for ((s, &c), &limit) in state.iter_mut().zip(costs).zip(&limits) {
-            let before = s.best_plane.saturating_sub(k);
-            let after = k.saturating_sub(s.run_end);
-            if before.max(after) > s.exclusion {
-                s.runner_up = s.runner_up.min(c);
-            }
-            if c <= limit {
-                s.low = s.low.min(k);
-                s.high = s.high.max(k);
-            }
+        let lanes = runner_up
+            .iter_mut()
+            .zip(low.iter_mut())
+            .zip(high.iter_mut())
+            .zip(best_plane.iter().zip(run_end.iter()))
+            .zip(exclusion.iter().zip(limits.iter()))
+            .zip(costs.iter());
+        for (((((runner_up, low), high), (&best_plane, &run_end)), (&exclusion, &limit)), &c) in
+            lanes
+        {
+            let beyond = best_plane.saturating_sub(k).max(k.saturating_sub(run_end)) > exclusion;
+            *runner_up = if beyond {
+                (*runner_up).min(c)
+            } else {
+                *runner_up
+            };
+            let in_range = c <= limit;
+            *low = if in_range { (*low).min(k) } else { *low };
+            *high = if in_range { (*high).max(k) } else { *high };
         }
+    }
+    for (i, s) in state.iter_mut().enumerate() {
+        (s.best, s.best_plane, s.run_end) = (best[i], best_plane[i], run_end[i]);
+        (s.left, s.right, s.runner_up) = (left[i], right[i], runner_up[i]);
+        (s.low, s.high) = (low[i], high[i]);
     }
     state
 }

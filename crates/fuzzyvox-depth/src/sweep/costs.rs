@@ -2,7 +2,6 @@
 //! the census distance to the nearest pixel there, and the mean over the views that see it,
 //! all branch-free so that the loops vectorise.
 
-use super::limits::MAX_SWEEP_VIEWS;
 use super::planes::Sweep;
 use super::rays::RowRays;
 use crate::census::{CENSUS_BITS, CENSUS_MAX_COST, CensusImage};
@@ -16,7 +15,9 @@ impl Sweep {
     /// Raw costs of reference row `y` on plane `k`, written into `out` (one per column): the
     /// mean census distance over the views in which the pixel lands on a valid pixel, scaled by
     /// [`COST_SCALE`], or the largest cost where it lands in none. `reference` holds the row's
-    /// tagged codes (see [`tagged_codes`]).
+    /// tagged codes (see [`tagged_codes`]). Inlined into the band's sweep, which is compiled
+    /// for several instruction sets.
+    #[inline(always)]
     pub(super) fn row_costs(
         &self,
         rays: RowRays<'_>,
@@ -40,9 +41,10 @@ impl Sweep {
             let b = view.translation.map(|v| v * inverse);
             let (w, h) = (other.width as f32, other.height as f32);
             let stride = other.width as u32;
-            // The nearest pixel of every column, branch-free so that it vectorises; -1 where
-            // the pixel lands outside the image (or behind the camera). Truncation equals
-            // floor for the non-negative values kept.
+            // The nearest pixel of every column, branch-free so that it vectorises; the
+            // image's trailing invalid code where the pixel lands outside the image (or behind
+            // the camera). Truncation equals floor for the non-negative values kept.
+            let outside = other.codes.len().saturating_sub(1);
             for (((j, &ax), &ay), &az) in landing.iter_mut().zip(xs).zip(ys).zip(zs) {
                 let qz = az + b[2];
                 let inv = 1.0 / qz;
@@ -51,14 +53,14 @@ impl Sweep {
                 let index = floor_small(v)
                     .wrapping_mul(stride)
                     .wrapping_add(floor_small(u));
-                *j = if inside { index as i32 } else { -1 };
+                *j = if inside { index } else { outside as u32 };
             }
-            for (g, &j) in gathered.iter_mut().zip(landing.iter()) {
-                *g = usize::try_from(j)
-                    .ok()
-                    .and_then(|j| other.codes.get(j))
-                    .copied()
-                    .unwrap_or(INVALID);
+            // Clamped to the trailing code, every read is in bounds without a test, so the
+            // loop becomes one gather per vector.
+            if let Some(codes) = other.codes.get(..=outside) {
+                for (g, &j) in gathered.iter_mut().zip(landing.iter()) {
+                    *g = codes[(j as usize).min(outside)];
+                }
             }
             // Distances where both codes are valid, again branch-free.
             for (((sum, count), &g), &c) in sums
@@ -99,10 +101,12 @@ const _: () = assert!(CENSUS_BITS <= 31);
 pub(super) struct TaggedImage {
     pub(super) width: usize,
     pub(super) height: usize,
+    /// Row-major codes, and one more [`INVALID`] code after the last pixel, for the pixels
+    /// that land outside the image.
     pub(super) codes: Vec<u32>,
 }
 
-/// The codes of `census` with invalid pixels tagged [`INVALID`].
+/// The codes of `census` with invalid pixels tagged [`INVALID`], and the trailing invalid code.
 pub(super) fn tagged_codes(census: &CensusImage) -> TaggedImage {
     TaggedImage {
         width: census.width,
@@ -112,39 +116,31 @@ pub(super) fn tagged_codes(census: &CensusImage) -> TaggedImage {
             .iter()
             .zip(&census.valid)
             .map(|(&code, &ok)| if ok { code } else { INVALID })
+            .chain([INVALID])
             .collect(),
     }
 }
 
-/// `ceil(2^18 / n)` for `n` = 0 ..= [`MAX_SWEEP_VIEWS`] (0 unused): dividing by a view count
-/// as a multiplication and a shift, exact for the numerators [`mean_cost`] forms.
-const RECIPROCALS: [u32; MAX_SWEEP_VIEWS + 1] = {
-    let mut table = [0u32; MAX_SWEEP_VIEWS + 1];
-    let mut n = 1;
-    while n <= MAX_SWEEP_VIEWS {
-        table[n] = (1u32 << 18).div_ceil(n as u32);
-        n += 1;
-    }
-    table
-};
-
-/// `round(sum · COST_SCALE / count)`, or the largest cost when no view saw the pixel.
-#[inline]
+/// `round(sum · COST_SCALE / count)`, or the largest cost when no view saw the pixel. In
+/// floats, which vectorise where a division or a table lookup would not: the numerator is at
+/// most `31 · 16 · 8 + 8 < 2^13` and the count at most
+/// [`MAX_SWEEP_VIEWS`](super::MAX_SWEEP_VIEWS), so a quotient that
+/// is not a whole number lies at least `1 / count` below the next one, far more than the float
+/// division's rounding error, and truncating the float quotient gives the integer one.
+#[inline(always)]
 fn mean_cost(sum: u16, count: u16) -> u8 {
-    match RECIPROCALS.get(usize::from(count)) {
-        Some(&reciprocal) if count > 0 => {
-            let count = u32::from(count);
-            // At most 31 · 16 · 8 + 8 < 2^13, so the product stays below 2^31 and the
-            // multiplication equals the division (numerator · count < 2^18).
-            (((u32::from(sum) * COST_SCALE + count / 2) * reciprocal) >> 18) as u8
-        }
-        _ => (u32::from(CENSUS_MAX_COST) * COST_SCALE) as u8,
+    let numerator = u32::from(sum) * COST_SCALE + u32::from(count) / 2;
+    let quotient = numerator as f32 / f32::from(count);
+    if count > 0 {
+        quotient as u8
+    } else {
+        (u32::from(CENSUS_MAX_COST) * COST_SCALE) as u8
     }
 }
 
 /// One row's scratch space for [`Sweep::row_costs`].
 pub(super) struct RowScratch {
-    landing: Vec<i32>,
+    landing: Vec<u32>,
     gathered: Vec<u32>,
     sums: Vec<u16>,
     counts: Vec<u16>,
@@ -164,7 +160,7 @@ impl RowScratch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::MAX_SWEEP_SIDE;
+    use crate::sweep::{MAX_SWEEP_SIDE, MAX_SWEEP_VIEWS};
 
     #[test]
     fn floor_small_is_floor_and_mean_cost_is_the_rounded_mean() {
