@@ -102,23 +102,54 @@ fn shift_min(
     centre: bool,
 ) -> Vec<f32> {
     let mut out = vec![f32::INFINITY; values.len()];
-    for y in 0..height {
-        for x in 0..width {
-            let (pos, len) = match axis {
-                Axis::Row => (x, width),
-                Axis::Column => (y, height),
-            };
-            let at = |p: usize| match axis {
-                Axis::Row => values[y * width + p],
-                Axis::Column => values[p * width + x],
-            };
-            let low = at(pos.saturating_sub(shift));
-            let high = at((pos + shift).min(len - 1));
-            let mut m = low.min(high);
-            if centre {
-                m = m.min(at(pos));
+    if width == 0 || height == 0 {
+        return out;
+    }
+    // `min(low, high)`, then with the centre: the same operations in the same order for every
+    // pixel, on whole rows so that they vectorise.
+    let combine = |out: &mut [f32], low: &[f32], high: &[f32], middle: &[f32]| {
+        for (((o, &l), &h), &m) in out.iter_mut().zip(low).zip(high).zip(middle) {
+            let low_high = l.min(h);
+            *o = if centre { low_high.min(m) } else { low_high };
+        }
+    };
+    let rows = values.chunks_exact(width).zip(out.chunks_exact_mut(width));
+    match axis {
+        Axis::Row => {
+            for (row, out) in rows {
+                // Columns whose both neighbours lie inside the row, then the clamped ones.
+                let inner = width.saturating_sub(2 * shift);
+                if inner > 0 {
+                    combine(
+                        &mut out[shift..shift + inner],
+                        &row[..inner],
+                        &row[2 * shift..],
+                        &row[shift..],
+                    );
+                }
+                for x in (0..width).filter(|&x| inner == 0 || x < shift || x >= shift + inner) {
+                    let (low, high) = (
+                        row[x.saturating_sub(shift)],
+                        row[(x + shift).min(width - 1)],
+                    );
+                    let low_high = low.min(high);
+                    out[x] = if centre {
+                        low_high.min(row[x])
+                    } else {
+                        low_high
+                    };
+                }
             }
-            out[y * width + x] = m;
+        }
+        Axis::Column => {
+            let row = |y: usize| &values[y * width..(y + 1) * width];
+            for (y, (middle, out)) in rows.enumerate() {
+                let (low, high) = (
+                    row(y.saturating_sub(shift)),
+                    row((y + shift).min(height - 1)),
+                );
+                combine(out, low, high, middle);
+            }
         }
     }
     out

@@ -67,42 +67,61 @@ impl CameraView {
         operator: &TConorm,
         delta: f32,
     ) -> Option<Box<Block<Evidence>>> {
-        // A voxel's footprint radius in pixels is `fx δ / z`.
-        let footprint = (self.fx.max(self.fy) as f32) * delta;
-        let size = self.resolution.size();
-        let first = self.to_camera(&self.resolution.center(key.origin()));
-        let step_x = self.camera_from_world.column(0) * size;
-        let step_y = self.camera_from_world.column(1) * size;
-        let step_z = self.camera_from_world.column(2) * size;
-        let mut block: Option<Box<Block<Evidence>>> = None;
-        for cell in 0..BLOCK_CELLS {
-            let (i, j, l) = (cell % 8, (cell / 8) % 8, cell / 64);
-            let p = first + step_x * i as f64 + step_y * j as f64 + step_z * l as f64;
-            if p.z <= 0.0 {
-                continue;
-            }
-            let u = (self.fx * p.x / p.z + self.cx + 0.5).floor();
-            let v = (self.fy * p.y / p.z + self.cy + 0.5).floor();
-            if !(u >= 0.0 && v >= 0.0 && u < f64::from(self.width) && v < f64::from(self.height)) {
-                continue;
-            }
-            let index = v as usize * self.width as usize + u as usize;
-            let z = p.z as f32;
-            let pixel = &pixels[index];
-            let evidence = match fill {
-                Some(fill) if !pixel.is_valid() => fill
-                    .lookup(index, footprint / z)
-                    .filter(|&(bound, _)| z < bound)
-                    .map(|(_, weight)| Evidence {
-                        occupied: 0.0,
-                        free: model.free(operator, weight),
-                    }),
-                _ => pixel.at(z, model, operator, delta),
-            };
-            if let Some(e) = evidence {
-                block.get_or_insert_with(Box::default).cells[cell] = e;
-            }
-        }
-        block
+        block_evidence(self, key, pixels, fill, model, operator, delta)
     }
+}
+
+/// [`CameraView::block_evidence`], compiled for AVX-512 and AVX2 as well (chosen at run time):
+/// the projection's divisions and floors then run as single instructions. The arithmetic is the
+/// same on every path, so is the evidence.
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
+    "x86_64+avx2+popcnt",
+))]
+fn block_evidence(
+    view: &CameraView,
+    key: BlockKey,
+    pixels: &[PixelEvidence],
+    fill: Option<&FootprintFill>,
+    model: &EvidenceModel,
+    operator: &TConorm,
+    delta: f32,
+) -> Option<Box<Block<Evidence>>> {
+    // A voxel's footprint radius in pixels is `fx δ / z`.
+    let footprint = (view.fx.max(view.fy) as f32) * delta;
+    let size = view.resolution.size();
+    let first = view.to_camera(&view.resolution.center(key.origin()));
+    let step_x = view.camera_from_world.column(0) * size;
+    let step_y = view.camera_from_world.column(1) * size;
+    let step_z = view.camera_from_world.column(2) * size;
+    let mut block: Option<Box<Block<Evidence>>> = None;
+    for cell in 0..BLOCK_CELLS {
+        let (i, j, l) = (cell % 8, (cell / 8) % 8, cell / 64);
+        let p = first + step_x * i as f64 + step_y * j as f64 + step_z * l as f64;
+        if p.z <= 0.0 {
+            continue;
+        }
+        let u = (view.fx * p.x / p.z + view.cx + 0.5).floor();
+        let v = (view.fy * p.y / p.z + view.cy + 0.5).floor();
+        if !(u >= 0.0 && v >= 0.0 && u < f64::from(view.width) && v < f64::from(view.height)) {
+            continue;
+        }
+        let index = v as usize * view.width as usize + u as usize;
+        let z = p.z as f32;
+        let pixel = &pixels[index];
+        let evidence = match fill {
+            Some(fill) if !pixel.is_valid() => fill
+                .lookup(index, footprint / z)
+                .filter(|&(bound, _)| z < bound)
+                .map(|(_, weight)| Evidence {
+                    occupied: 0.0,
+                    free: model.free(operator, weight),
+                }),
+            _ => pixel.at(z, model, operator, delta),
+        };
+        if let Some(e) = evidence {
+            block.get_or_insert_with(Box::default).cells[cell] = e;
+        }
+    }
+    block
 }
