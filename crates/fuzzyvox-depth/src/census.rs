@@ -64,59 +64,57 @@ const SPAN: usize = BLOCK + CENSUS_WIDTH - 1;
 /// The neighbours of each byte of the string, highest byte first (7, 8, 8 and 8 of them).
 const PLANES: [std::ops::Range<usize>; 4] = [0..7, 7..15, 15..23, 23..31];
 
-/// Census strings of the interior columns `start..start + out.len()` of one row (no clamping
-/// needed there), sixteen pixels at a time: the block's centres and the four bytes of its
-/// strings stay in SIMD registers while the 31 neighbours are compared, each comparison
-/// filling one bit of sixteen byte lanes. The last block overlaps the one before when the row
-/// is not a whole number of blocks (recomputing a string is harmless). Rows narrower than a
-/// block use the clamped loop. Compiled for AVX-512 and AVX2 as well, chosen at run time.
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-fn interior_codes(
-    rows: &[&[f32]; CENSUS_HEIGHT],
-    centre: &[f32],
-    out: &mut [CensusCode],
-    start: usize,
-) -> bool {
-    let n = out.len();
-    if n < BLOCK {
-        return false;
-    }
-    let rx = CENSUS_WIDTH / 2;
-    for block in (0..n).step_by(BLOCK) {
-        let at = block.min(n - BLOCK);
-        let Ok(centres) = <&[f32; BLOCK]>::try_from(&centre[at..at + BLOCK]) else {
-            continue;
-        };
-        // The block's window, as fixed-size rows: the neighbour loads then need no checks.
-        let from = start + at - rx;
-        let window: [Option<&[f32; SPAN]>; CENSUS_HEIGHT] =
-            std::array::from_fn(|r| rows[r].get(from..from + SPAN)?.try_into().ok());
-        let mut bytes = [[0u8; BLOCK]; 4];
-        for (plane, neighbours) in bytes.iter_mut().zip(PLANES) {
-            for &(r, k) in &NEIGHBOURS[neighbours] {
-                let Some(Ok(values)) =
-                    window[r].map(|row| <&[f32; BLOCK]>::try_from(&row[k..k + BLOCK]))
-                else {
-                    continue;
-                };
-                // All-ones masks of the comparisons as `i32` (as wide as the `f32` lanes), then
-                // narrowed into the byte lanes: `plane = 2 plane + bit`.
-                let less: [i32; BLOCK] =
-                    std::array::from_fn(|j| -i32::from(values[j] < centres[j]));
-                for j in 0..BLOCK {
-                    plane[j] = (plane[j] << 1).wrapping_sub(less[j] as u8);
+fuzzyvox_core::dispatched! {
+    /// Census strings of the interior columns `start..start + out.len()` of one row (no clamping
+    /// needed there), sixteen pixels at a time: the block's centres and the four bytes of its
+    /// strings stay in SIMD registers while the 31 neighbours are compared, each comparison
+    /// filling one bit of sixteen byte lanes. The last block overlaps the one before when the row
+    /// is not a whole number of blocks (recomputing a string is harmless). Rows narrower than a
+    /// block use the clamped loop. Compiled for AVX-512 and AVX2 as well, chosen at run time.
+    fn interior_codes(
+        rows: &[&[f32]; CENSUS_HEIGHT],
+        centre: &[f32],
+        out: &mut [CensusCode],
+        start: usize,
+    ) -> bool {
+        let n = out.len();
+        if n < BLOCK {
+            return false;
+        }
+        let rx = CENSUS_WIDTH / 2;
+        for block in (0..n).step_by(BLOCK) {
+            let at = block.min(n - BLOCK);
+            let Ok(centres) = <&[f32; BLOCK]>::try_from(&centre[at..at + BLOCK]) else {
+                continue;
+            };
+            // The block's window, as fixed-size rows: the neighbour loads then need no checks.
+            let from = start + at - rx;
+            let window: [Option<&[f32; SPAN]>; CENSUS_HEIGHT] =
+                std::array::from_fn(|r| rows[r].get(from..from + SPAN)?.try_into().ok());
+            let mut bytes = [[0u8; BLOCK]; 4];
+            for (plane, neighbours) in bytes.iter_mut().zip(PLANES) {
+                for &(r, k) in &NEIGHBOURS[neighbours] {
+                    let Some(Ok(values)) =
+                        window[r].map(|row| <&[f32; BLOCK]>::try_from(&row[k..k + BLOCK]))
+                    else {
+                        continue;
+                    };
+                    // All-ones masks of the comparisons as `i32` (as wide as the `f32` lanes), then
+                    // narrowed into the byte lanes: `plane = 2 plane + bit`.
+                    let less: [i32; BLOCK] =
+                        std::array::from_fn(|j| -i32::from(values[j] < centres[j]));
+                    for j in 0..BLOCK {
+                        plane[j] = (plane[j] << 1).wrapping_sub(less[j] as u8);
+                    }
                 }
             }
+            let [b0, b1, b2, b3] = &bytes;
+            for (j, code) in out[at..at + BLOCK].iter_mut().enumerate() {
+                *code = CensusCode::from_be_bytes([b0[j], b1[j], b2[j], b3[j]]);
+            }
         }
-        let [b0, b1, b2, b3] = &bytes;
-        for (j, code) in out[at..at + BLOCK].iter_mut().enumerate() {
-            *code = CensusCode::from_be_bytes([b0[j], b1[j], b2[j], b3[j]]);
-        }
-    }
-    true
+        true
+}
 }
 
 /// Computes the 9 × 7 census transform. Neighbours beyond the border repeat the border pixel

@@ -41,58 +41,56 @@ pub(super) struct ColumnScan {
     pub under_bound: u16,
 }
 
-/// Scans a pixel's column of window sums: the least sum and its first index, then, with the
-/// thresholds `thresholds[best]` = (range threshold, uniqueness bound), the span of sums at most
-/// the range threshold and how many lie under the uniqueness bound. `column.len()` must be a
-/// multiple of [`SCAN_LANES`] (a remainder is ignored): callers pad with `i16::MAX`, which no
-/// threshold accepts.
-///
-/// Only chunks of sixteen sums with one at or under a threshold can change the answer; the
-/// others (most of them: the thresholds are close to the least sum) are skipped after one
-/// vector test. Compiled for AVX-512 and AVX2 as well, chosen at run time.
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-pub(super) fn scan_column(column: &[i16], best_cost: i16, thresholds: &[(i16, i16)]) -> ColumnScan {
-    let (range_threshold, unique_bound) = thresholds
-        .get(best_cost.max(0) as usize)
-        .copied()
-        .unwrap_or((best_cost, 0));
-    let wanted = range_threshold.max(unique_bound.saturating_sub(1));
-    let (mut best, mut low, mut high, mut under) = (None, None, 0u32, 0u32);
-    for (base, chunk) in (0u32..)
-        .step_by(SCAN_LANES)
-        .zip(column.chunks_exact(SCAN_LANES))
-    {
-        // A fixed-size view: the compiler then knows the trip count and vectorises.
-        let Ok(chunk) = <&[i16; SCAN_LANES]>::try_from(chunk) else {
-            continue;
-        };
-        if lane_mask(chunk, |c| c <= wanted) == 0 {
-            continue;
+fuzzyvox_core::dispatched! {
+    /// Scans a pixel's column of window sums: the least sum and its first index, then, with the
+    /// thresholds `thresholds[best]` = (range threshold, uniqueness bound), the span of sums at most
+    /// the range threshold and how many lie under the uniqueness bound. `column.len()` must be a
+    /// multiple of [`SCAN_LANES`] (a remainder is ignored): callers pad with `i16::MAX`, which no
+    /// threshold accepts.
+    ///
+    /// Only chunks of sixteen sums with one at or under a threshold can change the answer; the
+    /// others (most of them: the thresholds are close to the least sum) are skipped after one
+    /// vector test. Compiled for AVX-512 and AVX2 as well, chosen at run time.
+    pub(super) fn scan_column(column: &[i16], best_cost: i16, thresholds: &[(i16, i16)]) -> ColumnScan {
+        let (range_threshold, unique_bound) = thresholds
+            .get(best_cost.max(0) as usize)
+            .copied()
+            .unwrap_or((best_cost, 0));
+        let wanted = range_threshold.max(unique_bound.saturating_sub(1));
+        let (mut best, mut low, mut high, mut under) = (None, None, 0u32, 0u32);
+        for (base, chunk) in (0u32..)
+            .step_by(SCAN_LANES)
+            .zip(column.chunks_exact(SCAN_LANES))
+        {
+            // A fixed-size view: the compiler then knows the trip count and vectorises.
+            let Ok(chunk) = <&[i16; SCAN_LANES]>::try_from(chunk) else {
+                continue;
+            };
+            if lane_mask(chunk, |c| c <= wanted) == 0 {
+                continue;
+            }
+            // One bit per lane (`pmovmskb`), then scalar bit scans: no lane reductions.
+            let equal = lane_mask(chunk, |c| c == best_cost);
+            let in_range = lane_mask(chunk, |c| c <= range_threshold);
+            if best.is_none() && equal != 0 {
+                best = Some(base + equal.trailing_zeros());
+            }
+            if in_range != 0 {
+                low.get_or_insert(base + in_range.trailing_zeros());
+                high = base + 31 - in_range.leading_zeros();
+            }
+            under += lane_mask(chunk, |c| c < unique_bound).count_ones();
         }
-        // One bit per lane (`pmovmskb`), then scalar bit scans: no lane reductions.
-        let equal = lane_mask(chunk, |c| c == best_cost);
-        let in_range = lane_mask(chunk, |c| c <= range_threshold);
-        if best.is_none() && equal != 0 {
-            best = Some(base + equal.trailing_zeros());
+        let best = best.unwrap_or(0) as u16;
+        ColumnScan {
+            best_cost,
+            best,
+            low: low.map_or(best, |l| (l as u16).min(best)),
+            high: (high as u16).max(best),
+            unique_bound,
+            under_bound: under as u16,
         }
-        if in_range != 0 {
-            low.get_or_insert(base + in_range.trailing_zeros());
-            high = base + 31 - in_range.leading_zeros();
-        }
-        under += lane_mask(chunk, |c| c < unique_bound).count_ones();
-    }
-    let best = best.unwrap_or(0) as u16;
-    ColumnScan {
-        best_cost,
-        best,
-        low: low.map_or(best, |l| (l as u16).min(best)),
-        high: (high as u16).max(best),
-        unique_bound,
-        under_bound: under as u16,
-    }
+}
 }
 
 /// Bit `k` set when lane `k` passes `test`; compiles to a vector compare and `pmovmskb`.

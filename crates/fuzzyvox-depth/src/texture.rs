@@ -103,50 +103,48 @@ impl Moments {
     }
 }
 
-/// The verdicts of rows `y0 ..` of `window`, as many as `out` holds. Compiled for AVX-512 and
-/// AVX2 as well, chosen at run time.
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-fn chunk_rows(window: &Window, y0: usize, out: &mut [bool]) {
-    let (w, h) = (window.width, window.height);
-    let row = |y: usize| window.pixels.get(y * w..(y + 1) * w).unwrap_or_default();
-    // The window's column sums, rows `y0 - ry ..= y0 + ry` clamped to the image (clamped
-    // rows are left out, not repeated).
-    let mut columns = vec![Moments::default(); w];
-    for y in y0.saturating_sub(window.ry)..(y0 + window.ry + 1).min(h) {
-        for (c, &v) in columns.iter_mut().zip(row(y)) {
-            c.add(v, 1.0);
-        }
-    }
-    let mut running = vec![Moments::default(); w + 1];
-    for (y, out) in (y0..).zip(out.chunks_exact_mut(w)) {
-        // Running sums along the row: `running[x]` holds columns `0..x`.
-        let mut total = Moments::default();
-        for (r, c) in running.iter_mut().skip(1).zip(&columns) {
-            total.count += c.count;
-            total.sum += c.sum;
-            total.squares += c.squares;
-            *r = total;
-        }
-        for (x, flat) in out.iter_mut().enumerate() {
-            let (x0, x1) = (x.saturating_sub(window.rx), (x + window.rx + 1).min(w));
-            let at = |x: usize| running.get(x).copied().unwrap_or_default();
-            *flat = at(x1).minus(at(x0)).flat(window.min_squared);
-        }
-        // Slide the column sums down one row.
-        if let Some(leaving) = y.checked_sub(window.ry) {
-            for (c, &v) in columns.iter_mut().zip(row(leaving)) {
-                c.add(v, -1.0);
-            }
-        }
-        if y + window.ry + 1 < h {
-            for (c, &v) in columns.iter_mut().zip(row(y + window.ry + 1)) {
+fuzzyvox_core::dispatched! {
+    /// The verdicts of rows `y0 ..` of `window`, as many as `out` holds. Compiled for AVX-512 and
+    /// AVX2 as well, chosen at run time.
+    fn chunk_rows(window: &Window, y0: usize, out: &mut [bool]) {
+        let (w, h) = (window.width, window.height);
+        let row = |y: usize| window.pixels.get(y * w..(y + 1) * w).unwrap_or_default();
+        // The window's column sums, rows `y0 - ry ..= y0 + ry` clamped to the image (clamped
+        // rows are left out, not repeated).
+        let mut columns = vec![Moments::default(); w];
+        for y in y0.saturating_sub(window.ry)..(y0 + window.ry + 1).min(h) {
+            for (c, &v) in columns.iter_mut().zip(row(y)) {
                 c.add(v, 1.0);
             }
         }
-    }
+        let mut running = vec![Moments::default(); w + 1];
+        for (y, out) in (y0..).zip(out.chunks_exact_mut(w)) {
+            // Running sums along the row: `running[x]` holds columns `0..x`.
+            let mut total = Moments::default();
+            for (r, c) in running.iter_mut().skip(1).zip(&columns) {
+                total.count += c.count;
+                total.sum += c.sum;
+                total.squares += c.squares;
+                *r = total;
+            }
+            for (x, flat) in out.iter_mut().enumerate() {
+                let (x0, x1) = (x.saturating_sub(window.rx), (x + window.rx + 1).min(w));
+                let at = |x: usize| running.get(x).copied().unwrap_or_default();
+                *flat = at(x1).minus(at(x0)).flat(window.min_squared);
+            }
+            // Slide the column sums down one row.
+            if let Some(leaving) = y.checked_sub(window.ry) {
+                for (c, &v) in columns.iter_mut().zip(row(leaving)) {
+                    c.add(v, -1.0);
+                }
+            }
+            if y + window.ry + 1 < h {
+                for (c, &v) in columns.iter_mut().zip(row(y + window.ry + 1)) {
+                    c.add(v, 1.0);
+                }
+            }
+        }
+}
 }
 
 /// Clears the match of every pixel of `map` that [`textureless`] marks in `image` (the image

@@ -127,17 +127,19 @@ fn shift_min(
                         &row[shift..],
                     );
                 }
-                for x in (0..width).filter(|&x| inner == 0 || x < shift || x >= shift + inner) {
-                    let (low, high) = (
-                        row[x.saturating_sub(shift)],
-                        row[(x + shift).min(width - 1)],
+                let clamped = if inner > 0 {
+                    (0..shift).chain(shift + inner..width)
+                } else {
+                    (0..width).chain(width..width)
+                };
+                for x in clamped {
+                    let (low, high) = (x.saturating_sub(shift), (x + shift).min(width - 1));
+                    combine(
+                        &mut out[x..=x],
+                        &row[low..=low],
+                        &row[high..=high],
+                        &row[x..=x],
                     );
-                    let low_high = low.min(high);
-                    out[x] = if centre {
-                        low_high.min(row[x])
-                    } else {
-                        low_high
-                    };
                 }
             }
         }

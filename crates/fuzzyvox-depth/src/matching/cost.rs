@@ -143,34 +143,32 @@ pub(super) fn enter_row(ctx: &Context, row: isize, band: &mut Band, slot: usize)
     }
 }
 
-/// Costs and enters consecutive columns whose disparities are all searchable: column `i` (of
-/// `codes`, `old` and `vertical`, `stride` lanes each) reads the planes from `start - i`.
-/// (Not inlined: on its own, the compiler knows that the slices do not overlap.)
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-fn enter_full_columns(
-    codes: &[CensusCode],
-    planes: [&[u8]; CODE_BYTES],
-    start: usize,
-    keep: &[u8],
-    old: &mut [u8],
-    vertical: &mut [i16],
-) {
-    let stride = keep.len();
-    // Padding lanes exist when the disparities are not a whole number of chunks.
-    let padded = keep.contains(&0);
-    let columns = old
-        .chunks_exact_mut(stride)
-        .zip(vertical.chunks_exact_mut(stride));
-    for (i, (&code, (old, vertical))) in codes.iter().zip(columns).enumerate() {
-        let at = start - i;
-        let q = planes.map(|plane| &plane[at..at + stride]);
-        if padded {
-            enter_full_column::<true>(code.to_le_bytes(), q, keep, old, vertical);
-        } else {
-            enter_full_column::<false>(code.to_le_bytes(), q, keep, old, vertical);
+fuzzyvox_core::dispatched! {
+    /// Costs and enters consecutive columns whose disparities are all searchable: column `i` (of
+    /// `codes`, `old` and `vertical`, `stride` lanes each) reads the planes from `start - i`.
+    /// (Not inlined: on its own, the compiler knows that the slices do not overlap.)
+    fn enter_full_columns(
+        codes: &[CensusCode],
+        planes: [&[u8]; CODE_BYTES],
+        start: usize,
+        keep: &[u8],
+        old: &mut [u8],
+        vertical: &mut [i16],
+    ) {
+        let stride = keep.len();
+        // Padding lanes exist when the disparities are not a whole number of chunks.
+        let padded = keep.contains(&0);
+        let columns = old
+            .chunks_exact_mut(stride)
+            .zip(vertical.chunks_exact_mut(stride));
+        for (i, (&code, (old, vertical))) in codes.iter().zip(columns).enumerate() {
+            let at = start - i;
+            let q = planes.map(|plane| &plane[at..at + stride]);
+            if padded {
+                enter_full_column::<true>(code.to_le_bytes(), q, keep, old, vertical);
+            } else {
+                enter_full_column::<false>(code.to_le_bytes(), q, keep, old, vertical);
+            }
         }
-    }
+}
 }

@@ -174,35 +174,33 @@ fn horizontal_row(
     }
 }
 
-/// One column of the running sum, `column = previous + add - sub`, sixteen lanes at a time.
-/// (Not inlined: inlined, the compiler loses track of `column` and `previous` being apart
-/// and compiles it one lane at a time.)
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) -> i16 {
-    let mut least = [i16::MAX; LANES];
-    let steps = column
-        .chunks_exact_mut(LANES)
-        .zip(previous.chunks_exact(LANES))
-        .zip(add.chunks_exact(LANES))
-        .zip(sub.chunks_exact(LANES));
-    for (((column, previous), add), sub) in steps {
-        let (Ok(column), Ok(previous), Ok(add), Ok(sub)) = (
-            <&mut [i16; LANES]>::try_from(column),
-            <&[i16; LANES]>::try_from(previous),
-            <&[i16; LANES]>::try_from(add),
-            <&[i16; LANES]>::try_from(sub),
-        ) else {
-            continue;
-        };
-        for k in 0..LANES {
-            column[k] = previous[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
-            least[k] = least[k].min(column[k]);
+fuzzyvox_core::dispatched! {
+    /// One column of the running sum, `column = previous + add - sub`, sixteen lanes at a time.
+    /// (Not inlined: inlined, the compiler loses track of `column` and `previous` being apart
+    /// and compiles it one lane at a time.)
+    fn slide(column: &mut [i16], previous: &[i16], add: &[i16], sub: &[i16]) -> i16 {
+        let mut least = [i16::MAX; LANES];
+        let steps = column
+            .chunks_exact_mut(LANES)
+            .zip(previous.chunks_exact(LANES))
+            .zip(add.chunks_exact(LANES))
+            .zip(sub.chunks_exact(LANES));
+        for (((column, previous), add), sub) in steps {
+            let (Ok(column), Ok(previous), Ok(add), Ok(sub)) = (
+                <&mut [i16; LANES]>::try_from(column),
+                <&[i16; LANES]>::try_from(previous),
+                <&[i16; LANES]>::try_from(add),
+                <&[i16; LANES]>::try_from(sub),
+            ) else {
+                continue;
+            };
+            for k in 0..LANES {
+                column[k] = previous[k].wrapping_add(add[k]).wrapping_sub(sub[k]);
+                least[k] = least[k].min(column[k]);
+            }
         }
-    }
-    min_lane(least)
+        min_lane(least)
+}
 }
 
 /// The floats of one row from its integer matches: the parabola's sub-pixel offset (the

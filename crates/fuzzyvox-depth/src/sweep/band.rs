@@ -24,32 +24,16 @@ pub(super) struct PixelState {
     pub(super) high: u32,
 }
 
-impl Default for PixelState {
-    fn default() -> Self {
-        Self {
-            best: u16::MAX,
-            best_plane: 0,
-            run_end: 0,
-            exclusion: 1,
-            left: u16::MAX,
-            right: u16::MAX,
-            runner_up: u16::MAX,
-            low: u32::MAX,
-            high: 0,
-        }
-    }
-}
-
 impl Sweep {
     /// Each pixel's rival exclusion (see [`PixelState::exclusion`]) for one reference row:
     /// how far the pixel moves, in its fastest view, from the farthest to the nearest plane
     /// (summed over eight legs, so that motion that turns is not undercounted), turned into the
     /// number of planes per pixel of motion, rounded (a pixel that moves about a pixel per plane
     /// keeps the one-plane bound of rectified rows).
-    fn exclusions(&self, rays: RowRays<'_>, row: &mut [PixelState]) {
+    fn exclusions(&self, rays: RowRays<'_>, row: &mut [u32]) {
         const LEGS: u32 = 8;
         let last = f64::from(self.planes - 1);
-        for (x, s) in row.iter_mut().enumerate() {
+        for (x, exclusion) in row.iter_mut().enumerate() {
             let mut motion = 0.0f32;
             for (v, view) in self.views.iter().enumerate() {
                 let (xs, ys, zs) = rays.view(v);
@@ -69,7 +53,7 @@ impl Sweep {
                 }
                 motion = motion.max(moved);
             }
-            s.exclusion = if motion.is_finite() && motion >= MIN_SWEEP_MOTION {
+            *exclusion = if motion.is_finite() && motion >= MIN_SWEEP_MOTION {
                 ((last as f32 / motion).round() as u32).max(1)
             } else {
                 u32::MAX
@@ -154,128 +138,132 @@ fn aggregate(
     }
 }
 
-/// Sweeps one band of rows `y0 .. y1` through every plane, twice, and returns its pixels' state.
-/// Compiled for AVX-512 and AVX2 as well (with the raw costs and the box sums inlined), chosen
-/// at run time.
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-pub(super) fn sweep_band(
-    sweep: &Sweep,
-    reference: &TaggedImage,
-    others: &[TaggedImage],
-    params: &MatchParams,
-    y0: usize,
-    y1: usize,
-) -> Vec<PixelState> {
-    let width = reference.width;
-    let height = reference.height;
-    let radius = (
-        params.window_width as usize / 2,
-        params.window_height as usize / 2,
-    );
-    let first = y0.saturating_sub(radius.1);
-    let last = (y1 + radius.1).min(height);
-    let rays = BandRays::new(sweep, first, last, width);
-    let mut raw = vec![0u8; (last - first) * width];
-    let mut horizontal = vec![0u16; raw.len()];
-    let mut scratch = RowScratch::new(width);
-    let n = (y1 - y0) * width;
-    // The band's aggregated costs on every plane, plane after plane.
-    let mut volume = vec![0u16; n * sweep.planes as usize];
-    for (k, costs) in volume.chunks_exact_mut(n).enumerate() {
-        for (r, row) in raw.chunks_exact_mut(width).enumerate() {
-            let y = first + r;
-            let codes = &reference.codes[y * width..(y + 1) * width];
-            sweep.row_costs(rays.row(r), k as u32, codes, others, &mut scratch, row);
-        }
-        aggregate(
-            &raw,
-            first,
-            width,
-            y0,
-            radius,
-            height,
-            &mut horizontal,
-            costs,
+fuzzyvox_core::dispatched! {
+    /// Sweeps one band of rows `y0 .. y1` through every plane, twice, and returns its pixels' state.
+    /// Compiled for AVX-512 and AVX2 as well (with the raw costs and the box sums inlined), chosen
+    /// at run time.
+    pub(super) fn sweep_band(
+        sweep: &Sweep,
+        reference: &TaggedImage,
+        others: &[TaggedImage],
+        params: &MatchParams,
+        y0: usize,
+        y1: usize,
+    ) -> Vec<PixelState> {
+        let width = reference.width;
+        let height = reference.height;
+        let radius = (
+            params.window_width as usize / 2,
+            params.window_height as usize / 2,
         );
-    }
-    let mut state = vec![PixelState::default(); n];
-    for (r, row) in state.chunks_exact_mut(width).enumerate() {
-        sweep.exclusions(rays.row(y0 - first + r), row);
-    }
-    // The two passes run on one array per field, with selects instead of branches, so that
-    // they vectorise; the states are assembled at the end.
-    let exclusion: Vec<u32> = state.iter().map(|s| s.exclusion).collect();
-    let (mut best, mut best_plane, mut run_end) = (vec![u16::MAX; n], vec![0u32; n], vec![0u32; n]);
-    let (mut left, mut right) = (vec![u16::MAX; n], vec![u16::MAX; n]);
-    // Pass 1: the best run of planes and the costs on either side of it.
-    let mut previous = vec![u16::MAX; n];
-    for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
-        let lanes = best
-            .iter_mut()
-            .zip(best_plane.iter_mut())
-            .zip(run_end.iter_mut())
-            .zip(left.iter_mut())
-            .zip(right.iter_mut())
-            .zip(exclusion.iter())
-            .zip(costs.iter().zip(previous.iter()));
-        for ((((((best, best_plane), run_end), left), right), &exclusion), (&c, &p)) in lanes {
-            // A new best starts a run; the plane right after the run either extends it (an
-            // equal cost, when a plane is less than a pixel of motion) or gives its right-hand
-            // cost.
-            let new_best = c < *best;
-            let next = !new_best && k == *run_end + 1 && *best != u16::MAX && *right == u16::MAX;
-            let extend = next && c == *best && exclusion > 1;
-            *right = if new_best {
-                u16::MAX
-            } else if next && !extend {
-                c
-            } else {
-                *right
-            };
-            *run_end = if new_best || extend { k } else { *run_end };
-            *best_plane = if new_best { k } else { *best_plane };
-            *left = if new_best { p } else { *left };
-            *best = if new_best { c } else { *best };
+        let first = y0.saturating_sub(radius.1);
+        let last = (y1 + radius.1).min(height);
+        let rays = BandRays::new(sweep, first, last, width);
+        let mut raw = vec![0u8; (last - first) * width];
+        let mut horizontal = vec![0u16; raw.len()];
+        let mut scratch = RowScratch::new(width);
+        let n = (y1 - y0) * width;
+        // The band's aggregated costs on every plane, plane after plane.
+        let mut volume = vec![0u16; n * sweep.planes as usize];
+        for (k, costs) in volume.chunks_exact_mut(n).enumerate() {
+            for (r, row) in raw.chunks_exact_mut(width).enumerate() {
+                let y = first + r;
+                let codes = &reference.codes[y * width..(y + 1) * width];
+                sweep.row_costs(rays.row(r), k as u32, codes, others, &mut scratch, row);
+            }
+            aggregate(
+                &raw,
+                first,
+                width,
+                y0,
+                radius,
+                height,
+                &mut horizontal,
+                costs,
+            );
         }
-        previous.copy_from_slice(costs);
-    }
-    // Pass 2: the best cost more than one pixel of motion beyond the run, and the cost-curve
-    // range.
-    let tolerance = 1.0 + f64::from(params.range_tolerance);
-    let limits: Vec<u16> = best
-        .iter()
-        .map(|&b| (f64::from(b) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
-        .collect();
-    let (mut runner_up, mut low, mut high) = (vec![u16::MAX; n], vec![u32::MAX; n], vec![0u32; n]);
-    for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
-        let lanes = runner_up
-            .iter_mut()
-            .zip(low.iter_mut())
-            .zip(high.iter_mut())
-            .zip(best_plane.iter().zip(run_end.iter()))
-            .zip(exclusion.iter().zip(limits.iter()))
-            .zip(costs.iter());
-        for (((((runner_up, low), high), (&best_plane, &run_end)), (&exclusion, &limit)), &c) in
-            lanes
-        {
-            let beyond = best_plane.saturating_sub(k).max(k.saturating_sub(run_end)) > exclusion;
-            *runner_up = if beyond {
-                (*runner_up).min(c)
-            } else {
-                *runner_up
-            };
-            let in_range = c <= limit;
-            *low = if in_range { (*low).min(k) } else { *low };
-            *high = if in_range { (*high).max(k) } else { *high };
+        // The passes run on one array per field, with selects instead of branches, so that
+        // they vectorise; the pixels' states are assembled at the end.
+        let mut exclusion = vec![1u32; n];
+        for (r, row) in exclusion.chunks_exact_mut(width).enumerate() {
+            sweep.exclusions(rays.row(y0 - first + r), row);
         }
-    }
-    for (i, s) in state.iter_mut().enumerate() {
-        (s.best, s.best_plane, s.run_end) = (best[i], best_plane[i], run_end[i]);
-        (s.left, s.right, s.runner_up) = (left[i], right[i], runner_up[i]);
-        (s.low, s.high) = (low[i], high[i]);
-    }
-    state
+        let (mut best, mut best_plane, mut run_end) = (vec![u16::MAX; n], vec![0u32; n], vec![0u32; n]);
+        let (mut left, mut right) = (vec![u16::MAX; n], vec![u16::MAX; n]);
+        // Pass 1: the best run of planes and the costs on either side of it.
+        let mut previous = vec![u16::MAX; n];
+        for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
+            let lanes = best
+                .iter_mut()
+                .zip(best_plane.iter_mut())
+                .zip(run_end.iter_mut())
+                .zip(left.iter_mut())
+                .zip(right.iter_mut())
+                .zip(exclusion.iter())
+                .zip(costs.iter().zip(previous.iter()));
+            for ((((((best, best_plane), run_end), left), right), &exclusion), (&c, &p)) in lanes {
+                // A new best starts a run; the plane right after the run either extends it (an
+                // equal cost, when a plane is less than a pixel of motion) or gives its right-hand
+                // cost.
+                let new_best = c < *best;
+                let next = !new_best && k == *run_end + 1 && *best != u16::MAX && *right == u16::MAX;
+                let extend = next && c == *best && exclusion > 1;
+                *right = if new_best {
+                    u16::MAX
+                } else if next && !extend {
+                    c
+                } else {
+                    *right
+                };
+                *run_end = if new_best || extend { k } else { *run_end };
+                *best_plane = if new_best { k } else { *best_plane };
+                *left = if new_best { p } else { *left };
+                *best = if new_best { c } else { *best };
+            }
+            previous.copy_from_slice(costs);
+        }
+        // Pass 2: the best cost more than one pixel of motion beyond the run, and the cost-curve
+        // range.
+        let tolerance = 1.0 + f64::from(params.range_tolerance);
+        let limits: Vec<u16> = best
+            .iter()
+            .map(|&b| (f64::from(b) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
+            .collect();
+        let (mut runner_up, mut low, mut high) = (vec![u16::MAX; n], vec![u32::MAX; n], vec![0u32; n]);
+        for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
+            let lanes = runner_up
+                .iter_mut()
+                .zip(low.iter_mut())
+                .zip(high.iter_mut())
+                .zip(best_plane.iter().zip(run_end.iter()))
+                .zip(exclusion.iter().zip(limits.iter()))
+                .zip(costs.iter());
+            for (((((runner_up, low), high), (&best_plane, &run_end)), (&exclusion, &limit)), &c) in
+                lanes
+            {
+                let beyond = best_plane.saturating_sub(k).max(k.saturating_sub(run_end)) > exclusion;
+                *runner_up = if beyond {
+                    (*runner_up).min(c)
+                } else {
+                    *runner_up
+                };
+                let in_range = c <= limit;
+                *low = if in_range { (*low).min(k) } else { *low };
+                *high = if in_range { (*high).max(k) } else { *high };
+            }
+        }
+        (0..n)
+            .map(|i| PixelState {
+                best: best[i],
+                best_plane: best_plane[i],
+                run_end: run_end[i],
+                exclusion: exclusion[i],
+                left: left[i],
+                right: right[i],
+                runner_up: runner_up[i],
+                low: low[i],
+                high: high[i],
+            })
+            .collect()
+}
 }

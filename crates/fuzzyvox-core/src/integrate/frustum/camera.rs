@@ -56,10 +56,14 @@ impl CameraView {
     pub(super) fn to_camera(&self, p: &Point3<f64>) -> Vector3<f64> {
         self.camera_from_world * (p.coords - self.camera_in_world)
     }
+}
 
-    /// Evidence for one block's voxels, or `None` when no voxel received any.
+crate::dispatched! {
+    /// Evidence for one block's voxels seen by `view`, or `None` when no voxel received any.
+    /// Dispatched to AVX-512 or AVX2 (`crate::dispatch`): the projection's divisions and floors
+    /// then run as single instructions, with the same results.
     pub(super) fn block_evidence(
-        &self,
+        view: &CameraView,
         key: BlockKey,
         pixels: &[PixelEvidence],
         fill: Option<&FootprintFill>,
@@ -67,61 +71,42 @@ impl CameraView {
         operator: &TConorm,
         delta: f32,
     ) -> Option<Box<Block<Evidence>>> {
-        block_evidence(self, key, pixels, fill, model, operator, delta)
-    }
+        // A voxel's footprint radius in pixels is `fx δ / z`.
+        let footprint = (view.fx.max(view.fy) as f32) * delta;
+        let size = view.resolution.size();
+        let first = view.to_camera(&view.resolution.center(key.origin()));
+        let step_x = view.camera_from_world.column(0) * size;
+        let step_y = view.camera_from_world.column(1) * size;
+        let step_z = view.camera_from_world.column(2) * size;
+        let mut block: Option<Box<Block<Evidence>>> = None;
+        for cell in 0..BLOCK_CELLS {
+            let (i, j, l) = (cell % 8, (cell / 8) % 8, cell / 64);
+            let p = first + step_x * i as f64 + step_y * j as f64 + step_z * l as f64;
+            if p.z <= 0.0 {
+                continue;
+            }
+            let u = (view.fx * p.x / p.z + view.cx + 0.5).floor();
+            let v = (view.fy * p.y / p.z + view.cy + 0.5).floor();
+            if !(u >= 0.0 && v >= 0.0 && u < f64::from(view.width) && v < f64::from(view.height)) {
+                continue;
+            }
+            let index = v as usize * view.width as usize + u as usize;
+            let z = p.z as f32;
+            let pixel = &pixels[index];
+            let evidence = match fill {
+                Some(fill) if !pixel.is_valid() => fill
+                    .lookup(index, footprint / z)
+                    .filter(|&(bound, _)| z < bound)
+                    .map(|(_, weight)| Evidence {
+                        occupied: 0.0,
+                        free: model.free(operator, weight),
+                    }),
+                _ => pixel.at(z, model, operator, delta),
+            };
+            if let Some(e) = evidence {
+                block.get_or_insert_with(Box::default).cells[cell] = e;
+            }
+        }
+        block
 }
-
-/// [`CameraView::block_evidence`], compiled for AVX-512 and AVX2 as well (chosen at run time):
-/// the projection's divisions and floors then run as single instructions. The arithmetic is the
-/// same on every path, so is the evidence.
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512bw+avx512vl+avx512bitalg+popcnt+bmi1+lzcnt",
-    "x86_64+avx2+popcnt",
-))]
-fn block_evidence(
-    view: &CameraView,
-    key: BlockKey,
-    pixels: &[PixelEvidence],
-    fill: Option<&FootprintFill>,
-    model: &EvidenceModel,
-    operator: &TConorm,
-    delta: f32,
-) -> Option<Box<Block<Evidence>>> {
-    // A voxel's footprint radius in pixels is `fx δ / z`.
-    let footprint = (view.fx.max(view.fy) as f32) * delta;
-    let size = view.resolution.size();
-    let first = view.to_camera(&view.resolution.center(key.origin()));
-    let step_x = view.camera_from_world.column(0) * size;
-    let step_y = view.camera_from_world.column(1) * size;
-    let step_z = view.camera_from_world.column(2) * size;
-    let mut block: Option<Box<Block<Evidence>>> = None;
-    for cell in 0..BLOCK_CELLS {
-        let (i, j, l) = (cell % 8, (cell / 8) % 8, cell / 64);
-        let p = first + step_x * i as f64 + step_y * j as f64 + step_z * l as f64;
-        if p.z <= 0.0 {
-            continue;
-        }
-        let u = (view.fx * p.x / p.z + view.cx + 0.5).floor();
-        let v = (view.fy * p.y / p.z + view.cy + 0.5).floor();
-        if !(u >= 0.0 && v >= 0.0 && u < f64::from(view.width) && v < f64::from(view.height)) {
-            continue;
-        }
-        let index = v as usize * view.width as usize + u as usize;
-        let z = p.z as f32;
-        let pixel = &pixels[index];
-        let evidence = match fill {
-            Some(fill) if !pixel.is_valid() => fill
-                .lookup(index, footprint / z)
-                .filter(|&(bound, _)| z < bound)
-                .map(|(_, weight)| Evidence {
-                    occupied: 0.0,
-                    free: model.free(operator, weight),
-                }),
-            _ => pixel.at(z, model, operator, delta),
-        };
-        if let Some(e) = evidence {
-            block.get_or_insert_with(Box::default).cells[cell] = e;
-        }
-    }
-    block
 }

@@ -20,7 +20,7 @@ mod end_points;
 mod pixel;
 mod tiles;
 
-use camera::CameraView;
+use camera::{CameraView, block_evidence};
 use cull::frustum_box;
 use end_points::mark_end_points;
 use pixel::{PixelEvidence, pixel_evidence};
@@ -116,8 +116,8 @@ pub fn depth_evidence(
     let blocks: Vec<(BlockKey, Box<Block<Evidence>>)> = candidates
         .par_iter()
         .filter_map(|&key| {
-            camera
-                .block_evidence(key, &pixels, fill.as_ref(), model, operator, half_diagonal)
+            let fill = fill.as_ref();
+            block_evidence(&camera, key, &pixels, fill, model, operator, half_diagonal)
                 .map(|b| (key, b))
         })
         .collect();
@@ -203,8 +203,15 @@ mod tests {
             assert!(kept.len() < all.len(), "frame {index}: nothing culled");
             let mut with_evidence = 0;
             for &key in &all {
-                let evidence =
-                    camera.block_evidence(key, &pixels, None, &model, &operator, half_diagonal);
+                let evidence = block_evidence(
+                    &camera,
+                    key,
+                    &pixels,
+                    None,
+                    &model,
+                    &operator,
+                    half_diagonal,
+                );
                 if evidence.is_some() {
                     with_evidence += 1;
                     assert!(
