@@ -33,6 +33,7 @@
 pub use fuzzyvox_ops as ops;
 
 pub mod class;
+#[macro_use]
 pub mod dispatch;
 pub mod error;
 pub mod file;

@@ -9,7 +9,7 @@ use std::path::Path;
 /// The core's modules from the bottom up; a module may use the modules of lower layers only
 /// (and `ops`, the operators crate, from anywhere).
 const LAYERS: &[&[&str]] = &[
-    &["class", "error"],
+    &["class", "dispatch", "error"],
     &["measures", "geometry", "storage"],
     &["integrate", "image"],
     &["map"],

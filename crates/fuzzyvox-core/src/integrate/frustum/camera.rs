@@ -58,7 +58,7 @@ impl CameraView {
     }
 }
 
-crate::dispatched! {
+dispatched! {
     /// Evidence for one block's voxels seen by `view`, or `None` when no voxel received any.
     /// Dispatched to AVX-512 or AVX2 (`crate::dispatch`): the projection's divisions and floors
     /// then run as single instructions, with the same results.
