@@ -314,6 +314,11 @@ impl CostField {
         self.voxels.get(index).map_or(f32::INFINITY, |v| v.rate)
     }
 
+    /// The rates of `len` voxels from dense index `first` on (a row of the region along x).
+    pub(crate) fn rates_of_row(&self, first: usize, len: usize) -> impl Iterator<Item = f32> + '_ {
+        self.voxels[first..first + len].iter().map(|v| v.rate)
+    }
+
     /// The lowest cost per metre of any traversable voxel (at least 1): every step of length `l`
     /// costs at least `l × min_rate`, which keeps A*'s distance heuristic consistent and tight.
     pub fn min_rate(&self) -> f32 {

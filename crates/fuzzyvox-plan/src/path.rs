@@ -6,10 +6,10 @@ use fuzzyvox_core::storage::VoxelKey;
 use nalgebra::Point3;
 use serde::Serialize;
 
-use crate::astar::astar;
+use crate::astar::{Unreached, astar};
 use crate::cost_field::CostField;
 use crate::error::PlanError;
-use crate::graph::VoxelGraph;
+use crate::heuristic::{GoalProfile, octile};
 use crate::smooth::{merge_collinear, segment_voxels, shortcut};
 
 /// A planned path.
@@ -58,14 +58,60 @@ pub fn plan_in_field_avoiding(
     search(field, start, goal, avoid)
 }
 
-/// The planning of [`plan_in_field_avoiding`], generic over `avoid` so that
-/// [`plan_in_field`] pays nothing for it.
+/// [`plan_in_field_avoiding`] that gives up after expanding `max_expanded` voxels: `Ok(None)`
+/// then. For a caller that already has a path and only looks for a better one (the closed
+/// loop's periodic replan), so that the look costs a bounded time.
+pub fn plan_in_field_within(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
+    max_expanded: usize,
+) -> Result<Option<Path>, PlanError> {
+    match search_within(field, start, goal, avoid, max_expanded) {
+        Err(Stop::Plan(error)) => Err(error),
+        Err(Stop::Limit) => Ok(None),
+        Ok(path) => Ok(Some(path)),
+    }
+}
+
+/// Why [`search_within`] returned no path.
+enum Stop {
+    Plan(PlanError),
+    Limit,
+}
+
+impl From<PlanError> for Stop {
+    fn from(error: PlanError) -> Self {
+        Self::Plan(error)
+    }
+}
+
+/// [`search_within`] without a limit.
 fn search<A: Fn(usize) -> bool + ?Sized>(
     field: &CostField,
     start: VoxelKey,
     goal: VoxelKey,
     avoid: &A,
 ) -> Result<Path, PlanError> {
+    search_within(field, start, goal, avoid, usize::MAX).map_err(|stop| match stop {
+        Stop::Plan(error) => error,
+        // No search expands more voxels than there are.
+        Stop::Limit => PlanError::Disconnected {
+            expanded: usize::MAX,
+        },
+    })
+}
+
+/// The planning of [`plan_in_field_within`], generic over `avoid` so that [`plan_in_field`]
+/// pays nothing for it.
+fn search_within<A: Fn(usize) -> bool + ?Sized>(
+    field: &CostField,
+    start: VoxelKey,
+    goal: VoxelKey,
+    avoid: &A,
+    max_expanded: usize,
+) -> Result<Path, Stop> {
     let region = field.region();
     let start_index = region
         .index_of(start)
@@ -74,38 +120,29 @@ fn search<A: Fn(usize) -> bool + ?Sized>(
         .index_of(goal)
         .ok_or(PlanError::OutOfRegion("goal"))?;
     if let Some(why) = field.blocker(start_index) {
-        return Err(PlanError::StartUnsafe(why));
+        return Err(PlanError::StartUnsafe(why).into());
     }
     if let Some(why) = field.blocker(goal_index) {
-        return Err(PlanError::GoalUnsafe(why));
+        return Err(PlanError::GoalUnsafe(why).into());
     }
     if goal_index != start_index && avoid(goal_index) {
-        return Err(PlanError::GoalAvoided);
+        return Err(PlanError::GoalAvoided.into());
     }
-    // Metres of the shortest 26-connected route times the lowest rate: never more than the
-    // true remaining cost, and consistent because every step costs at least its length times
-    // that rate.
-    let size = field.resolution().size() as f32 * field.min_rate();
-    let heuristic = |key: VoxelKey| {
-        let mut d = [
-            (key.x - goal.x).unsigned_abs() as f32,
-            (key.y - goal.y).unsigned_abs() as f32,
-            (key.z - goal.z).unsigned_abs() as f32,
-        ];
-        d.sort_unstable_by(|a, b| b.total_cmp(a));
-        let sqrt3 = 1.732_050_8_f32;
-        size * ((d[0] - d[1]) + std::f32::consts::SQRT_2 * (d[1] - d[2]) + sqrt3 * d[2])
-    };
-    let graph = VoxelGraph::new(field);
+    // Exact within one and a half times the start's distance of the goal (plus a margin),
+    // where the search stays unless it must go round much of the region.
+    let heuristic = GoalProfile::new(field, goal, 1.5 * octile(start, goal) + 8.0);
     let route = astar(
-        graph,
-        region.len(),
+        field,
         start_index,
         goal_index,
-        |index| heuristic(region.key_at(index)),
+        |key| heuristic.cost_to_goal(key),
         avoid,
+        max_expanded,
     )
-    .map_err(|expanded| PlanError::Disconnected { expanded })?;
+    .map_err(|why| match why {
+        Unreached::Disconnected { expanded } => Stop::Plan(PlanError::Disconnected { expanded }),
+        Unreached::Limit => Stop::Limit,
+    })?;
     let voxels: Vec<VoxelKey> = route.nodes.iter().map(|&i| region.key_at(i)).collect();
     let enter =
         |index: usize| field.is_traversable(index) && (index == start_index || !avoid(index));
@@ -171,6 +208,25 @@ pub(crate) mod tests {
             ..PlannerConfig::default()
         };
         CostField::build(&map, region, config).unwrap()
+    }
+
+    /// A search within a budget gives the unlimited search's path when the budget covers it,
+    /// and `None` (not an error) when it does not; refusals come first either way.
+    #[test]
+    fn a_budget_stops_the_search_without_failing_it() {
+        let field = open_field(true);
+        let (start, goal) = (VoxelKey::new(5, 20, 10), VoxelKey::new(35, 20, 10));
+        let full = plan_in_field(&field, start, goal).unwrap();
+        let never = |_: usize| false;
+        let within = plan_in_field_within(&field, start, goal, &never, full.expanded).unwrap();
+        assert_eq!(within, Some(full.clone()));
+        let short = plan_in_field_within(&field, start, goal, &never, full.expanded - 1).unwrap();
+        assert_eq!(short, None);
+        let pillar = VoxelKey::new(20, 20, 10);
+        assert!(matches!(
+            plan_in_field_within(&field, start, pillar, &never, 1),
+            Err(PlanError::GoalUnsafe(_))
+        ));
     }
 
     /// A wall of avoided voxels across the straight line bends the path around it; no

@@ -46,6 +46,8 @@ pub struct Planner {
     field: CostField,
     /// The map's write version the field reflects (`None` for maps that do not report one).
     version: Option<u64>,
+    /// How many updates changed the field.
+    generation: u64,
 }
 
 impl Planner {
@@ -54,6 +56,7 @@ impl Planner {
         Ok(Self {
             field: CostField::build(map, region, config)?,
             version: map.write_version(),
+            generation: 0,
         })
     }
 
@@ -68,7 +71,7 @@ impl Planner {
             _ => None,
         };
         self.version = now;
-        match changed {
+        let update = match changed {
             Some(blocks) => self.field.update(map, &blocks),
             None => {
                 let region = *self.field.region();
@@ -82,7 +85,18 @@ impl Planner {
                     ..FieldUpdate::default()
                 }
             }
+        };
+        if update.rebuilt || update.voxels_changed > 0 || update.voxels_flipped > 0 {
+            self.generation += 1;
         }
+        update
+    }
+
+    /// A count that grows with every update that changed the field (a voxel's class, safety,
+    /// clearance or cost, or a rebuild): while it stays the same, every plan through the field
+    /// gives the same result.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// The current field.
