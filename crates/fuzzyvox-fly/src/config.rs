@@ -68,6 +68,11 @@ pub struct FlyConfig {
     /// The planner keeps its path while it stays valid, but replans at least every this many
     /// frames to use what the map has learnt. Default 8.
     pub replan_every: usize,
+    /// That periodic replan only looks for a better path while the current one stays clear,
+    /// so it gives up after expanding this many voxels and keeps the path (a path that is no
+    /// longer clear is replanned without a limit). It keeps a frame from paying a long search
+    /// for an improvement: 20,000 voxels is about 8 ms. Default 20,000.
+    pub replan_budget: usize,
     /// The unseen-surface guard collects, within this distance of the vehicle, metres, the
     /// unknown voxels next to surfaces the map has seen, and the planner neither enters them
     /// nor passes within the vehicle's radius of them, whatever the unknown-space policy: see
@@ -116,6 +121,7 @@ impl Default for FlyConfig {
             look_turn: 45.0,
             weave_frames: 2,
             replan_every: 8,
+            replan_budget: 20_000,
             unknown_guard: 0.0,
             guard_surface_reach: 0.6,
             leaning_occupied: 0.2,
@@ -209,6 +215,13 @@ impl FlyConfig {
                 expected: "at least 1 frame",
             });
         }
+        if self.replan_budget == 0 {
+            return Err(Error::InvalidParameter {
+                name: "replan budget",
+                value: 0.0,
+                expected: "at least 1 voxel",
+            });
+        }
         self.planner.validate()?;
         Ok(self)
     }
@@ -216,5 +229,38 @@ impl FlyConfig {
     /// Metres flown per frame.
     pub fn step(&self) -> f64 {
         self.speed * self.frame_interval
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults are valid; a loop that never replans, or a replan that may expand no
+    /// voxel, is refused with the setting's name.
+    #[test]
+    fn out_of_range_settings_are_named() {
+        assert!(FlyConfig::default().validate().is_ok());
+        for (config, setting) in [
+            (
+                FlyConfig {
+                    replan_every: 0,
+                    ..FlyConfig::default()
+                },
+                "replan every",
+            ),
+            (
+                FlyConfig {
+                    replan_budget: 0,
+                    ..FlyConfig::default()
+                },
+                "replan budget",
+            ),
+        ] {
+            assert!(
+                matches!(config.validate(), Err(Error::InvalidParameter { name, .. }) if name == setting),
+                "{setting}"
+            );
+        }
     }
 }

@@ -206,6 +206,12 @@ impl UnknownGuard {
         }
     }
 
+    /// The forbidden voxels (dense indices), in the order the last update found them: while
+    /// this list stays the same, so does what the guard forbids.
+    pub fn forbidden_voxels(&self) -> &[usize] {
+        &self.marked
+    }
+
     /// Whether the voxel at a dense index of the field's region is forbidden.
     pub fn forbids(&self, index: usize) -> bool {
         self.forbidden.get(index).copied().unwrap_or(false)

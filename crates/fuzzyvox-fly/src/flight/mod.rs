@@ -34,6 +34,7 @@ use crate::region::planning_region;
 use geometry::level;
 pub use log::{CycleTimes, Ending, FlightLog};
 pub use prior::integrate_prior;
+use replan::{ReplanInputs, Replanned};
 pub use steer::{LOOK_FRAMES, REACHED_VOXELS, STALL_FRAMES, VIEW_MARGIN};
 
 /// Flies from `start` to `goal` with `map` (which holds what the vehicle knew before;
@@ -79,6 +80,8 @@ pub struct Flight<'a> {
     window: ViewWindow,
     previous: Option<Frame>,
     path: Option<Vec<Point3<f64>>>,
+    /// The last replan's inputs and what it gave, reused while the inputs stay the same.
+    last_replan: Option<(ReplanInputs, Replanned)>,
     position: Point3<f64>,
     heading: Vector3<f64>,
     pitch: f64,
@@ -138,6 +141,7 @@ impl<'a> Flight<'a> {
             window: ViewWindow::new(config.views)?,
             previous: None,
             path: None,
+            last_replan: None,
             position: *start,
             heading: level(goal - start).unwrap_or_else(Vector3::x),
             pitch: 0.0,

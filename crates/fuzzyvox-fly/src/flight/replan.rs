@@ -1,20 +1,44 @@
 //! Planning from where the vehicle is: A* through the cost field, or towards the reachable
-//! voxel nearest the goal when the goal cannot be reached yet.
+//! voxel nearest the goal when the goal cannot be reached yet; within a budget of expanded
+//! voxels when the vehicle only looks for a better path.
 
 use fuzzyvox_core::storage::VoxelKey;
-use fuzzyvox_plan::{CostField, PlanError, plan_in_field_avoiding};
+use fuzzyvox_plan::{CostField, PlanError, plan_in_field_within};
 use nalgebra::Point3;
+
+/// What a replan depends on besides the flight's goal: the cost field (through the planner's
+/// [generation](fuzzyvox_plan::Planner::generation)), the voxels the guard forbids, where the
+/// vehicle is, and the search's limit. Equal inputs give an equal plan.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct ReplanInputs {
+    pub(super) generation: u64,
+    pub(super) forbidden: Vec<usize>,
+    pub(super) position: Point3<f64>,
+    pub(super) limit: usize,
+}
+
+/// What a replan gave.
+#[derive(Clone, Debug)]
+pub(super) enum Replanned {
+    /// A path from the vehicle.
+    Path(Vec<Point3<f64>>),
+    /// The search reached its limit: keep the current path.
+    Kept,
+    /// No path.
+    Failed,
+}
 
 /// Plans through `field` from `position` to the goal. When the voxel the vehicle is in cannot
 /// be entered (the map learnt that something is near), plans from the nearest traversable
 /// voxel within half a metre instead. Never enters a voxel `avoid` names (the start
-/// excepted).
+/// excepted). Each search expands at most `limit` voxels; `Ok(None)` when one ran out.
 pub(super) fn replan(
     field: &CostField,
     position: Point3<f64>,
     goal: VoxelKey,
     avoid: &dyn Fn(usize) -> bool,
-) -> std::result::Result<Vec<Point3<f64>>, PlanError> {
+    limit: usize,
+) -> std::result::Result<Option<Vec<Point3<f64>>>, PlanError> {
     let resolution = field.resolution();
     let region = *field.region();
     let here = resolution.key_of(&position)?;
@@ -41,7 +65,7 @@ pub(super) fn replan(
         }
         _ => here,
     };
-    let mut path = match plan_in_field_avoiding(field, start, goal, avoid) {
+    let found = match plan_in_field_within(field, start, goal, avoid, limit) {
         // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
         // it (the known-safe frontier towards the goal), see more, and plan again there.
         Err(PlanError::GoalUnsafe(_) | PlanError::GoalAvoided | PlanError::Disconnected { .. }) => {
@@ -50,15 +74,18 @@ pub(super) fn replan(
             if resolution.center(target) == resolution.center(start) {
                 return Err(PlanError::Disconnected { expanded: 0 });
             }
-            plan_in_field_avoiding(field, start, target, avoid)?
+            plan_in_field_within(field, start, target, avoid, limit)?
         }
         other => other?,
+    };
+    let Some(mut path) = found else {
+        return Ok(None);
     };
     // The path starts where the vehicle is, not at its voxel's centre.
     if let Some(first) = path.waypoints.first_mut() {
         *first = position;
     }
-    Ok(path.waypoints)
+    Ok(Some(path.waypoints))
 }
 
 /// The traversable voxel connected to `start` (through the field's 26-neighbourhood) nearest

@@ -14,7 +14,7 @@ use nalgebra::Vector3;
 use super::Flight;
 use super::geometry::{level, point_ahead, turn_towards};
 use super::log::CycleTimes;
-use super::replan::replan;
+use super::replan::{ReplanInputs, Replanned, replan};
 
 impl Flight<'_> {
     /// The picture the camera takes now: towards the point ahead on the path, or along the
@@ -111,20 +111,54 @@ impl Flight<'_> {
         let t = Instant::now();
         let guard = &self.guard;
         let avoid = |index: usize| guard.forbids(index);
-        let keep = self.since_plan < self.config.replan_every
-            && self
-                .path
-                .as_deref()
-                .is_some_and(|p| p.len() >= 2 && self.planner.is_clear_avoiding(p, &avoid));
-        if keep {
+        let clear = self
+            .path
+            .as_deref()
+            .is_some_and(|p| p.len() >= 2 && self.planner.is_clear_avoiding(p, &avoid));
+        if clear && self.since_plan < self.config.replan_every {
             self.since_plan += 1;
         } else {
-            // A path that goes nowhere (the vehicle's own voxel is the nearest it can reach) is
-            // no path: the vehicle side-steps to look, and gives up after `STALL_FRAMES`, instead
-            // of hovering on it until the time runs out.
-            self.path = replan(self.planner.field(), self.position, self.goal_key, &avoid)
-                .ok()
-                .filter(|p| p.len() >= 2);
+            // A clear path is only looked at again for a better one, within the budget; a
+            // blocked one is replanned whatever it costs. A path that goes nowhere (the
+            // vehicle's own voxel is the nearest it can reach) is no path: the vehicle
+            // side-steps to look, and gives up after `STALL_FRAMES`, instead of hovering on it
+            // until the time runs out.
+            let limit = if clear {
+                self.config.replan_budget
+            } else {
+                usize::MAX
+            };
+            // A vehicle that has not moved, in a field and guard that have not changed (it
+            // waits for a picture with some baseline), would search again for the same plan.
+            let inputs = ReplanInputs {
+                generation: self.planner.generation(),
+                forbidden: guard.forbidden_voxels().to_vec(),
+                position: self.position,
+                limit,
+            };
+            let outcome = match &self.last_replan {
+                Some((seen, outcome)) if *seen == inputs => outcome.clone(),
+                _ => {
+                    let outcome = match replan(
+                        self.planner.field(),
+                        self.position,
+                        self.goal_key,
+                        &avoid,
+                        limit,
+                    ) {
+                        Ok(Some(path)) => Replanned::Path(path),
+                        Ok(None) => Replanned::Kept,
+                        Err(_) => Replanned::Failed,
+                    };
+                    self.last_replan = Some((inputs, outcome.clone()));
+                    outcome
+                }
+            };
+            match outcome {
+                Replanned::Path(path) => self.path = Some(path).filter(|p| p.len() >= 2),
+                Replanned::Kept => {}
+                Replanned::Failed => self.path = None,
+            }
             self.log.replans += 1;
             self.since_plan = 0;
         }
