@@ -1,8 +1,8 @@
 //! A* over a cost field's 26-connected voxels, with dense per-voxel arrays and the caller's
 //! heuristic. It walks the same graph as [`VoxelGraph`](crate::VoxelGraph) (whose edges
 //! petgraph's algorithms see, and `tests/plan.rs` checks that both agree), but steps to the 26
-//! neighbours by fixed index offsets and knows each voxel's coordinates, so an expansion costs
-//! no division and no bounds test away from the region's faces.
+//! neighbours by fixed index offsets from the expanded voxel's coordinates (one division per
+//! expansion, none per neighbour, and no bounds test away from the region's faces).
 
 use dary_heap::QuaternaryHeap;
 use std::cmp::Reverse;
@@ -26,8 +26,8 @@ pub(crate) struct Route {
 /// A* from `start` to `goal` (dense indices) through the traversable voxels of `field`, never
 /// entering a voxel for which `avoid` is true (the start is never tested). A step of length
 /// `l` costs `l × (r₁ + r₂) / 2` ([`VoxelGraph`](crate::VoxelGraph)'s edge weight).
-/// `heuristic` must be consistent: the first time a voxel is expanded its cost is final. Ties in the open set are broken by index, so the result
-/// is deterministic.
+/// `heuristic` must be consistent: the first time a voxel is expanded its cost is final. Ties
+/// in the open set are broken by index, so the result is deterministic.
 ///
 /// Expands at most `limit` voxels. Returns the route, or why there is none.
 pub(crate) fn astar<H, A>(

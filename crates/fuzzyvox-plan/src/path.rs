@@ -41,7 +41,7 @@ pub fn plan_in_field(
     start: VoxelKey,
     goal: VoxelKey,
 ) -> Result<Path, PlanError> {
-    search(field, start, goal, &|_| false)
+    unlimited(field, search(field, start, goal, &|_| false, None))
 }
 
 /// [`plan_in_field`] that also never enters a voxel (dense index) for which `avoid` is true,
@@ -55,7 +55,15 @@ pub fn plan_in_field_avoiding(
     goal: VoxelKey,
     avoid: &dyn Fn(usize) -> bool,
 ) -> Result<Path, PlanError> {
-    search(field, start, goal, avoid)
+    unlimited(field, search(field, start, goal, avoid, None))
+}
+
+/// A search without a limit always ends with a path or an error: it can expand every voxel.
+/// (The `None` arm only keeps the types honest.)
+fn unlimited(field: &CostField, found: Result<Option<Path>, PlanError>) -> Result<Path, PlanError> {
+    found?.ok_or(PlanError::Disconnected {
+        expanded: field.region().len(),
+    })
 }
 
 /// [`plan_in_field_avoiding`] that gives up after expanding `max_expanded` voxels: `Ok(None)`
@@ -68,50 +76,18 @@ pub fn plan_in_field_within(
     avoid: &dyn Fn(usize) -> bool,
     max_expanded: usize,
 ) -> Result<Option<Path>, PlanError> {
-    match search_within(field, start, goal, avoid, max_expanded) {
-        Err(Stop::Plan(error)) => Err(error),
-        Err(Stop::Limit) => Ok(None),
-        Ok(path) => Ok(Some(path)),
-    }
+    search(field, start, goal, avoid, Some(max_expanded))
 }
 
-/// Why [`search_within`] returned no path.
-enum Stop {
-    Plan(PlanError),
-    Limit,
-}
-
-impl From<PlanError> for Stop {
-    fn from(error: PlanError) -> Self {
-        Self::Plan(error)
-    }
-}
-
-/// [`search_within`] without a limit.
+/// The planning of [`plan_in_field_within`], generic over `avoid` so that [`plan_in_field`]
+/// pays nothing for it. Without a limit the result is never `Ok(None)`.
 fn search<A: Fn(usize) -> bool + ?Sized>(
     field: &CostField,
     start: VoxelKey,
     goal: VoxelKey,
     avoid: &A,
-) -> Result<Path, PlanError> {
-    search_within(field, start, goal, avoid, usize::MAX).map_err(|stop| match stop {
-        Stop::Plan(error) => error,
-        // No search expands more voxels than there are.
-        Stop::Limit => PlanError::Disconnected {
-            expanded: usize::MAX,
-        },
-    })
-}
-
-/// The planning of [`plan_in_field_within`], generic over `avoid` so that [`plan_in_field`]
-/// pays nothing for it.
-fn search_within<A: Fn(usize) -> bool + ?Sized>(
-    field: &CostField,
-    start: VoxelKey,
-    goal: VoxelKey,
-    avoid: &A,
-    max_expanded: usize,
-) -> Result<Path, Stop> {
+    limit: Option<usize>,
+) -> Result<Option<Path>, PlanError> {
     let region = field.region();
     let start_index = region
         .index_of(start)
@@ -120,13 +96,13 @@ fn search_within<A: Fn(usize) -> bool + ?Sized>(
         .index_of(goal)
         .ok_or(PlanError::OutOfRegion("goal"))?;
     if let Some(why) = field.blocker(start_index) {
-        return Err(PlanError::StartUnsafe(why).into());
+        return Err(PlanError::StartUnsafe(why));
     }
     if let Some(why) = field.blocker(goal_index) {
-        return Err(PlanError::GoalUnsafe(why).into());
+        return Err(PlanError::GoalUnsafe(why));
     }
     if goal_index != start_index && avoid(goal_index) {
-        return Err(PlanError::GoalAvoided.into());
+        return Err(PlanError::GoalAvoided);
     }
     // Exact within one and a half times the start's distance of the goal (plus a margin),
     // where the search stays unless it must go round much of the region.
@@ -137,12 +113,15 @@ fn search_within<A: Fn(usize) -> bool + ?Sized>(
         goal_index,
         |key| heuristic.cost_to_goal(key),
         avoid,
-        max_expanded,
-    )
-    .map_err(|why| match why {
-        Unreached::Disconnected { expanded } => Stop::Plan(PlanError::Disconnected { expanded }),
-        Unreached::Limit => Stop::Limit,
-    })?;
+        limit.unwrap_or(usize::MAX),
+    );
+    let route = match route {
+        Ok(route) => route,
+        Err(Unreached::Limit) => return Ok(None),
+        Err(Unreached::Disconnected { expanded }) => {
+            return Err(PlanError::Disconnected { expanded });
+        }
+    };
     let voxels: Vec<VoxelKey> = route.nodes.iter().map(|&i| region.key_at(i)).collect();
     let enter =
         |index: usize| field.is_traversable(index) && (index == start_index || !avoid(index));
@@ -162,14 +141,14 @@ fn search_within<A: Fn(usize) -> bool + ?Sized>(
         min_safety = field.safety(start_index);
         min_clearance = field.clearance(start_index);
     }
-    Ok(Path {
+    Ok(Some(Path {
         waypoints,
         length,
         cost: f64::from(route.cost),
         min_safety,
         min_clearance,
         expanded: route.expanded,
-    })
+    }))
 }
 
 #[cfg(test)]

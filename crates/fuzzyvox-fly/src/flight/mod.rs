@@ -34,7 +34,7 @@ use crate::region::planning_region;
 use geometry::level;
 pub use log::{CycleTimes, Ending, FlightLog};
 pub use prior::integrate_prior;
-use replan::{ReplanInputs, Replanned};
+use replan::LastReplan;
 pub use steer::{LOOK_FRAMES, REACHED_VOXELS, STALL_FRAMES, VIEW_MARGIN};
 
 /// Flies from `start` to `goal` with `map` (which holds what the vehicle knew before;
@@ -81,7 +81,7 @@ pub struct Flight<'a> {
     previous: Option<Frame>,
     path: Option<Vec<Point3<f64>>>,
     /// The last replan's inputs and what it gave, reused while the inputs stay the same.
-    last_replan: Option<(ReplanInputs, Replanned)>,
+    last_replan: LastReplan,
     position: Point3<f64>,
     heading: Vector3<f64>,
     pitch: f64,
@@ -141,7 +141,7 @@ impl<'a> Flight<'a> {
             window: ViewWindow::new(config.views)?,
             previous: None,
             path: None,
-            last_replan: None,
+            last_replan: LastReplan::default(),
             position: *start,
             heading: level(goal - start).unwrap_or_else(Vector3::x),
             pitch: 0.0,

@@ -28,11 +28,50 @@ pub(super) enum Replanned {
     Failed,
 }
 
+/// The last replan's inputs and what it gave.
+#[derive(Clone, Debug, Default)]
+pub(super) struct LastReplan(Option<(ReplanInputs, Replanned)>);
+
+impl LastReplan {
+    /// What a replan with `inputs` gives: the last outcome when the inputs are the same (a
+    /// vehicle waiting in place for a picture with some baseline, in a field and guard that
+    /// have not changed, would search again for the same plan), otherwise `plan()`'s.
+    pub(super) fn outcome(
+        &mut self,
+        inputs: ReplanInputs,
+        plan: impl FnOnce() -> Replanned,
+    ) -> Replanned {
+        match &self.0 {
+            Some((seen, outcome)) if *seen == inputs => outcome.clone(),
+            _ => {
+                let outcome = plan();
+                self.0 = Some((inputs, outcome.clone()));
+                outcome
+            }
+        }
+    }
+}
+
+/// [`plan_from`] as a [`Replanned`].
+pub(super) fn replan(
+    field: &CostField,
+    position: Point3<f64>,
+    goal: VoxelKey,
+    avoid: &dyn Fn(usize) -> bool,
+    limit: usize,
+) -> Replanned {
+    match plan_from(field, position, goal, avoid, limit) {
+        Ok(Some(path)) => Replanned::Path(path),
+        Ok(None) => Replanned::Kept,
+        Err(_) => Replanned::Failed,
+    }
+}
+
 /// Plans through `field` from `position` to the goal. When the voxel the vehicle is in cannot
 /// be entered (the map learnt that something is near), plans from the nearest traversable
 /// voxel within half a metre instead. Never enters a voxel `avoid` names (the start
 /// excepted). Each search expands at most `limit` voxels; `Ok(None)` when one ran out.
-pub(super) fn replan(
+fn plan_from(
     field: &CostField,
     position: Point3<f64>,
     goal: VoxelKey,
@@ -132,4 +171,53 @@ fn nearest_reachable(
         }
     }
     Some(region.key_at(best.1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The last outcome comes back while the inputs are equal; any changed input plans again.
+    #[test]
+    fn equal_inputs_reuse_the_last_replan() {
+        let inputs = ReplanInputs {
+            generation: 3,
+            forbidden: vec![7, 9],
+            position: Point3::new(1.0, 2.0, 3.0),
+            limit: 10,
+        };
+        let mut last = LastReplan::default();
+        let mut plans = 0u32;
+        let mut plan = |last: &mut LastReplan, inputs: &ReplanInputs| {
+            last.outcome(inputs.clone(), || {
+                plans += 1;
+                Replanned::Path(vec![Point3::new(f64::from(plans), 0.0, 0.0)])
+            })
+        };
+        let first = plan(&mut last, &inputs);
+        let again = plan(&mut last, &inputs);
+        assert!(matches!((&first, &again), (Replanned::Path(a), Replanned::Path(b)) if a == b));
+        let changes = [
+            ReplanInputs {
+                generation: 4,
+                ..inputs.clone()
+            },
+            ReplanInputs {
+                forbidden: vec![7],
+                ..inputs.clone()
+            },
+            ReplanInputs {
+                position: Point3::new(1.0, 2.0, 3.5),
+                ..inputs.clone()
+            },
+            ReplanInputs {
+                limit: usize::MAX,
+                ..inputs.clone()
+            },
+        ];
+        for changed in &changes {
+            plan(&mut last, changed);
+        }
+        assert_eq!(plans as usize, 1 + changes.len());
+    }
 }

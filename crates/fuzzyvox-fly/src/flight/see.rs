@@ -128,32 +128,16 @@ impl Flight<'_> {
             } else {
                 usize::MAX
             };
-            // A vehicle that has not moved, in a field and guard that have not changed (it
-            // waits for a picture with some baseline), would search again for the same plan.
             let inputs = ReplanInputs {
                 generation: self.planner.generation(),
                 forbidden: guard.forbidden_voxels().to_vec(),
                 position: self.position,
                 limit,
             };
-            let outcome = match &self.last_replan {
-                Some((seen, outcome)) if *seen == inputs => outcome.clone(),
-                _ => {
-                    let outcome = match replan(
-                        self.planner.field(),
-                        self.position,
-                        self.goal_key,
-                        &avoid,
-                        limit,
-                    ) {
-                        Ok(Some(path)) => Replanned::Path(path),
-                        Ok(None) => Replanned::Kept,
-                        Err(_) => Replanned::Failed,
-                    };
-                    self.last_replan = Some((inputs, outcome.clone()));
-                    outcome
-                }
-            };
+            let (planner, position, goal) = (&self.planner, self.position, self.goal_key);
+            let outcome = self.last_replan.outcome(inputs, || {
+                replan(planner.field(), position, goal, &avoid, limit)
+            });
             match outcome {
                 Replanned::Path(path) => self.path = Some(path).filter(|p| p.len() >= 2),
                 Replanned::Kept => {}
