@@ -20,7 +20,7 @@ mod see;
 mod steer;
 
 use fuzzyvox_core::error::Result;
-use fuzzyvox_core::integrate::IntegrationOptions;
+use fuzzyvox_core::integrate::{DepthFrame, IntegrationOptions};
 use fuzzyvox_core::map::AnyMap;
 use fuzzyvox_core::storage::VoxelKey;
 use fuzzyvox_depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
@@ -35,7 +35,9 @@ use geometry::level;
 pub use log::{CycleTimes, Ending, FlightLog};
 pub use prior::integrate_prior;
 use replan::LastReplan;
-pub use steer::{LOOK_FRAMES, REACHED_VOXELS, STALL_FRAMES, VIEW_MARGIN};
+pub use steer::{
+    BLIND_SHARE, DEPTH_SHARE, LOOK_FRAMES, NEAR_SHARE, REACHED_VOXELS, STALL_FRAMES, VIEW_MARGIN,
+};
 
 /// Flies from `start` to `goal` with `map` (which holds what the vehicle knew before;
 /// [`integrate_prior`] gives it its surroundings), seeing the scene through the scenario's
@@ -53,6 +55,22 @@ pub fn fly_goal(
         flight.cycle(map)?;
     }
     Ok(flight.into_log())
+}
+
+/// A depth image the vehicle got, with the share of its pixels that hold a depth.
+#[derive(Clone)]
+struct Sight {
+    frame: DepthFrame,
+    coverage: f64,
+}
+
+impl Sight {
+    fn new(frame: DepthFrame) -> Self {
+        let depth = frame.image().depth();
+        let measured = depth.iter().filter(|z| z.is_finite() && **z > 0.0).count();
+        let coverage = measured as f64 / depth.len().max(1) as f64;
+        Self { frame, coverage }
+    }
 }
 
 /// One closed-loop flight in progress: the vehicle's state between cycles.
@@ -87,6 +105,9 @@ pub struct Flight<'a> {
     pitch: f64,
     /// The camera's pose at the last picture: what the vehicle has just seen.
     camera: Option<Isometry3<f64>>,
+    /// The last depth image: what the vehicle has measured most recently (a picture taken
+    /// where the vehicle held has no baseline and gives none, so the one before still holds).
+    sight: Option<Sight>,
     since_plan: usize,
     stalled: usize,
     /// The camera's heading when the vehicle last side-stepped to look ahead (`None` before
@@ -94,9 +115,11 @@ pub struct Flight<'a> {
     looked: Option<Vector3<f64>>,
     /// The frame of the last look aside.
     looked_at: usize,
-    /// A step the vehicle held back because it headed outside the last picture: the next
-    /// picture looks along it.
+    /// A step the vehicle held back because it headed outside the last picture (or at
+    /// something within reach): the next picture looks along it.
     aim: Option<Point3<f64>>,
+    /// Whether the vehicle held its position last frame for want of a step it could take.
+    held: bool,
     frame_index: usize,
     max_frames: usize,
     /// The nearest the vehicle has come to the goal, metres, and the frame it came there (by
@@ -146,11 +169,13 @@ impl<'a> Flight<'a> {
             heading: level(goal - start).unwrap_or_else(Vector3::x),
             pitch: 0.0,
             camera: None,
+            sight: None,
             since_plan: 0,
             stalled: 0,
             looked: None,
             looked_at: 0,
             aim: None,
+            held: false,
             frame_index: 0,
             max_frames: (config.time_limit / config.frame_interval).ceil() as usize,
             nearest: (goal - start).norm(),

@@ -11,10 +11,10 @@ use fuzzyvox_sim::render;
 use fuzzyvox_sim::trajectory::look_at;
 use nalgebra::Vector3;
 
-use super::Flight;
 use super::geometry::{level, point_ahead, turn_towards};
 use super::log::CycleTimes;
 use super::replan::{ReplanInputs, Replanned, replan};
+use super::{Flight, Sight};
 
 impl Flight<'_> {
     /// The picture the camera takes now: towards the point ahead on the path, or along the
@@ -82,6 +82,7 @@ impl Flight<'_> {
                     map.as_map_mut().integrate_depth(&depth, &self.options)?;
                     times.integrate_ms = ms(t);
                     self.log.depth_images += 1;
+                    self.sight = Some(Sight::new(depth));
                 }
                 Err(_) => self.log.depth_refused += 1,
             }

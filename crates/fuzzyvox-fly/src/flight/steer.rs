@@ -26,6 +26,23 @@ pub const STALL_FRAMES: usize = 12;
 /// looked.
 pub const VIEW_MARGIN: f64 = 0.1;
 
+/// A step into unknown space must not head at something the last depth image shows within
+/// reach: it is refused when at least this share of the image's pixels around the step's
+/// direction (within the vehicle's outline) that hold a depth, of any confidence, hold one
+/// nearer than [`FlyConfig::min_depth`](crate::FlyConfig::min_depth) beyond the step's end.
+/// Once the vehicle is that near, the depth stage no longer looks there.
+pub const NEAR_SHARE: f64 = 0.1;
+
+/// A depth image with fewer of its pixels holding a depth than this shows nothing: the camera
+/// is too near whatever fills its view for the depth stage to match it, or its view is blank.
+/// Every step into unknown space counts as heading at something within reach until a better
+/// picture comes.
+pub const BLIND_SHARE: f64 = 0.05;
+
+/// The share of those pixels that must hold a depth at all for [`NEAR_SHARE`] to apply (the
+/// sky holds none).
+pub const DEPTH_SHARE: f64 = 0.01;
+
 impl Flight<'_> {
     /// Advances along the path (or side-steps when there is none), checks the step against the
     /// true scene, and ends the flight at a collision, at the goal or after too many frames
@@ -49,12 +66,21 @@ impl Flight<'_> {
                         self.path = Some(ahead);
                         along
                     }
-                    // The path heads into unknown space the camera has not seen: turn the step
-                    // towards the view, or hold and look along the step in the next picture.
-                    None => match self.toward_view(along) {
+                    // The path heads into unknown space the camera has not seen, or at
+                    // something within reach: turn the step towards the view, or step aside so
+                    // that the next picture has a baseline across the view, or hold and look
+                    // along the step in the next picture. A picture taken where the vehicle
+                    // held has no baseline and gives no depth, so after one hold the vehicle
+                    // steps back to where it was before instead.
+                    None => match self
+                        .toward_view(along)
+                        .or_else(|| self.side_step(step, self.frame_index % 2 == 1))
+                        .or_else(|| self.held.then(|| self.step_back()).flatten())
+                    {
                         Some(next) => next,
                         None => {
                             self.aim = Some(along);
+                            self.held = true;
                             return;
                         }
                     },
@@ -62,6 +88,7 @@ impl Flight<'_> {
                 if let Some(current) = self.path.as_mut() {
                     current[0] = next;
                 }
+                self.held = false;
                 next
             }
             _ => {
@@ -164,29 +191,109 @@ impl Flight<'_> {
         if !due {
             return None;
         }
-        let aside = self.heading.cross(&Vector3::z()) * step;
-        let clear = |next: Point3<f64>| {
-            self.planner
-                .is_clear_avoiding(&[self.position, next], &|i| self.guard.forbids(i))
-                && self.sees(next)
-        };
-        let next = [self.position + aside, self.position - aside]
-            .into_iter()
-            .find(|&next| clear(next))?;
+        let next = self.side_step(step, false)?;
         self.looked = Some(self.heading);
         self.looked_at = self.frame_index;
         Some(next)
     }
 
+    /// The step back to the last position the vehicle flew from: the space the vehicle has
+    /// just flown through is free whatever its map says, and the step gives the next picture a
+    /// baseline.
+    fn step_back(&self) -> Option<Point3<f64>> {
+        self.log
+            .trajectory
+            .iter()
+            .rev()
+            .find(|p| (*p - self.position).norm() > 1e-6)
+            .copied()
+    }
+
+    /// A step of `step` metres square to the camera's heading, to the left (to the right first
+    /// when `right_first`), or the other way when the map and the guard do not hold the first
+    /// clear or [`Flight::sees`] refuses it; `None` when neither side will do.
+    fn side_step(&self, step: f64, right_first: bool) -> Option<Point3<f64>> {
+        let aside = self.heading.cross(&Vector3::z()) * step;
+        let sides = if right_first {
+            [self.position - aside, self.position + aside]
+        } else {
+            [self.position + aside, self.position - aside]
+        };
+        sides.into_iter().find(|&next| {
+            self.planner
+                .is_clear_avoiding(&[self.position, next], &|i| self.guard.forbids(i))
+                && self.sees(next)
+        })
+    }
+
     /// Whether the straight step from the vehicle to `next` keeps out of unknown voxels, or
-    /// heads into the picture the camera has just taken ([`VIEW_MARGIN`] inside its edges);
-    /// always with [`FlyConfig::blind_steps`].
+    /// heads into the picture the camera has just taken ([`VIEW_MARGIN`] inside its edges) and
+    /// not at something its depth image shows within reach ([`Flight::near_ahead`]); always with
+    /// [`FlyConfig::blind_steps`].
     /// Unknown space is crossed at a cost, but only where the camera looks: a path that
     /// descends more steeply than the camera pitches (or a step to the side) otherwise flies
     /// the vehicle into space no frame has shown it, such as the inside of a tree crown whose
     /// top it saw from above.
     fn sees(&self, next: Point3<f64>) -> bool {
-        self.config.blind_steps || !self.enters_unknown(next) || self.in_view(next)
+        self.config.blind_steps
+            || !self.enters_unknown(next)
+            || (self.in_view(next) && !self.near_ahead(next))
+    }
+
+    /// Whether the last depth image shows something within reach ahead of the step to `next`:
+    /// of its pixels within the vehicle's outline around the direction of the step, seen at
+    /// [`FlyConfig::min_depth`] beyond the step's end, at least [`NEAR_SHARE`] of those that
+    /// hold a depth (when at least [`DEPTH_SHARE`] of them do) hold one nearer than that. Depth
+    /// of any confidence counts: a camera flying straight at a surface puts it at the epipole
+    /// of its motion, where the depth stage finds it but trusts it too little for the map, and
+    /// once the vehicle is nearer than the least depth the stage looks for, no picture will
+    /// show it again. An image with depth in fewer than [`BLIND_SHARE`] of all its pixels is
+    /// blind, and counts as showing something everywhere. Reads the last depth image the
+    /// vehicle got (a picture taken where it held gives none); `false` before the first one
+    /// and when the direction lies outside it.
+    fn near_ahead(&self, next: Point3<f64>) -> bool {
+        let (Some(sight), Some(direction)) =
+            (&self.sight, (next - self.position).try_normalize(1e-9))
+        else {
+            return false;
+        };
+        if sight.coverage < BLIND_SHARE {
+            return true;
+        }
+        let reach = self.config.min_depth + (next - self.position).norm();
+        let sight = &sight.frame;
+        let k = sight.intrinsics();
+        let local = sight
+            .world_from_camera()
+            .inverse_transform_point(&(self.position + direction * reach));
+        let Some(pixel) = k.project(&local) else {
+            return false;
+        };
+        let image = sight.image();
+        let (w, h) = (i64::from(image.width()), i64::from(image.height()));
+        let r = (k.fx() * self.config.planner.vehicle_radius / local.z)
+            .ceil()
+            .clamp(0.0, (w + h) as f64) as i64;
+        let (u, v) = (pixel.x.floor() as i64, pixel.y.floor() as i64);
+        let depth = image.depth();
+        let reach = reach as f32;
+        let (mut pixels, mut measured, mut near) = (0usize, 0usize, 0usize);
+        for y in (v - r).max(0)..=(v + r).min(h - 1) {
+            for x in (u - r).max(0)..=(u + r).min(w - 1) {
+                if (x - u).pow(2) + (y - v).pow(2) > r * r {
+                    continue;
+                }
+                pixels += 1;
+                let z = depth[(y * w + x) as usize];
+                if z.is_finite() && z > 0.0 {
+                    measured += 1;
+                    near += usize::from(z < reach);
+                }
+            }
+        }
+        measured as f64 >= DEPTH_SHARE * pixels as f64
+            && measured > 0
+            && near as f64 >= NEAR_SHARE * measured as f64
     }
 
     /// Whether the direction from the vehicle to `next` lies inside the last picture, at least
@@ -241,5 +348,87 @@ impl Flight<'_> {
                         .planner
                         .is_clear_avoiding(&[self.position, next], &|i| self.guard.forbids(i))
             })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use fuzzyvox_core::integrate::{DepthFrame, IntervalDepthImage};
+    use fuzzyvox_core::map::MapKind;
+    use fuzzyvox_sim::scenario;
+    use fuzzyvox_sim::trajectory::look_at;
+
+    use super::*;
+    use crate::FlyConfig;
+    use crate::flight::Sight;
+
+    /// Whether a flight at `start`, looking along +x with a depth image whose pixels hold
+    /// `depth(column, row)`, finds something within reach of a step of 0.5 m along +x.
+    fn near_ahead_with(depth: impl Fn(u32, u32) -> f32) -> bool {
+        let scenario = scenario::wall().unwrap();
+        let config = FlyConfig::default();
+        let start = Point3::new(0.0, 0.0, 3.0);
+        let goal = Point3::new(8.0, 0.0, 3.0);
+        let map = MapKind::Fuzzy.new_map(config.resolution).unwrap();
+        let mut flight = Flight::new(&scenario, &start, &goal, &map, &config, 1).unwrap();
+        let k = scenario.intrinsics;
+        let (w, h) = (k.width(), k.height());
+        let plane: Vec<f32> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| depth(x, y))
+            .collect();
+        let near: Vec<f32> = plane.iter().map(|z| z * 0.9).collect();
+        let far: Vec<f32> = plane.iter().map(|z| z * 1.1).collect();
+        let confidence = vec![0.01; plane.len()];
+        let image = IntervalDepthImage::new(w, h, near, plane, far, confidence).unwrap();
+        let pose = look_at(start, Vector3::x());
+        flight.sight = Some(Sight::new(DepthFrame::new(k, pose, image).unwrap()));
+        flight.near_ahead(start + Vector3::x() * 0.5)
+    }
+
+    #[test]
+    fn a_step_at_depth_within_reach_is_refused_whatever_its_confidence() {
+        // A surface 1.2 m ahead, nearer than the least depth (1 m) beyond the step's end:
+        // refused, though every pixel's confidence is 0.01.
+        assert!(near_ahead_with(|_, _| 1.2));
+        // Far depth lets the step go on.
+        assert!(!near_ahead_with(|_, _| 12.0));
+        // A picture with (almost) no depth anywhere is blind: refused.
+        assert!(near_ahead_with(|_, _| f32::NAN));
+        assert!(near_ahead_with(|x, y| if x == 0 && y == 0 {
+            12.0
+        } else {
+            f32::NAN
+        }));
+        // No depth straight ahead in a picture that has some elsewhere (the sky above the
+        // ground) lets the step go on.
+        let k = scenario::camera().unwrap();
+        let ground = k.height() * 3 / 4;
+        assert!(!near_ahead_with(|_, y| if y > ground {
+            12.0
+        } else {
+            f32::NAN
+        }));
+        // A few stray near matches among far ones do not stop it; a tenth of them does.
+        let scattered = |every: u32| {
+            move |x: u32, y: u32| {
+                if (x + y).is_multiple_of(every) {
+                    1.2
+                } else {
+                    12.0
+                }
+            }
+        };
+        assert!(!near_ahead_with(scattered(20)));
+        assert!(near_ahead_with(scattered(5)));
+        // Near depth off to the side of the step's direction does not count.
+        let left_edge = (k.width() / 8) as f32;
+        assert!(!near_ahead_with(|x, _| if (x as f32) < left_edge {
+            1.2
+        } else {
+            12.0
+        }));
     }
 }
