@@ -182,6 +182,13 @@ impl IntervalDepthImage {
         &self.confidence
     }
 
+    /// Whether pixel `index` (row-major) holds a depth: its `P0` is finite and positive,
+    /// whatever its interval and confidence. `false` outside the image.
+    #[inline]
+    pub fn has_depth(&self, index: usize) -> bool {
+        self.depth.get(index).is_some_and(|&z| depth_valid(z))
+    }
+
     /// Number of valid pixels.
     pub fn valid_pixels(&self) -> usize {
         (0..self.depth.len())
@@ -352,6 +359,18 @@ impl DepthFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    #[allow(clippy::unwrap_used)]
+    fn a_pixel_has_depth_when_its_middle_depth_is_finite_and_positive() {
+        let depth = vec![2.0, f32::NAN, 0.0, -1.0, f32::INFINITY, 5.0];
+        let near: Vec<f32> = depth.iter().map(|z| z * 0.5).collect();
+        let far: Vec<f32> = depth.iter().map(|z| z * 2.0).collect();
+        let image = IntervalDepthImage::new(3, 2, near, depth, far, vec![0.0; 6]).unwrap();
+        let has: Vec<bool> = (0..7).map(|i| image.has_depth(i)).collect();
+        // Zero confidence does not matter; outside the image there is none.
+        assert_eq!(has, [true, false, false, false, false, true, false]);
+    }
 
     #[test]
     fn validates_sizes_order_and_confidence() {

@@ -23,7 +23,9 @@ use fuzzyvox_core::error::Result;
 use fuzzyvox_core::integrate::{DepthFrame, IntegrationOptions};
 use fuzzyvox_core::map::AnyMap;
 use fuzzyvox_core::storage::VoxelKey;
-use fuzzyvox_depth::{DepthParams, ForwardMotion, Frame, ViewWindow};
+use fuzzyvox_depth::{
+    DepthParams, ForwardMotion, Frame, GrayImage, MatchParams, ViewWindow, textureless,
+};
 use fuzzyvox_plan::Planner;
 use fuzzyvox_sim::scenario::Scenario;
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -36,7 +38,8 @@ pub use log::{CycleTimes, Ending, FlightLog};
 pub use prior::integrate_prior;
 use replan::LastReplan;
 pub use steer::{
-    BLIND_SHARE, DEPTH_SHARE, LOOK_FRAMES, NEAR_SHARE, REACHED_VOXELS, STALL_FRAMES, VIEW_MARGIN,
+    BLIND_QUALITY, BLIND_SHARE, DEPTH_SHARE, LOOK_FRAMES, NEAR_SHARE, REACHED_VOXELS, STALL_FRAMES,
+    VIEW_MARGIN,
 };
 
 /// Flies from `start` to `goal` with `map` (which holds what the vehicle knew before;
@@ -57,19 +60,32 @@ pub fn fly_goal(
     Ok(flight.into_log())
 }
 
-/// A depth image the vehicle got, with the share of its pixels that hold a depth.
+/// A depth image the vehicle got, and whether it is blind ([`BLIND_SHARE`]).
 #[derive(Clone)]
 struct Sight {
     frame: DepthFrame,
-    coverage: f64,
+    blind: bool,
 }
 
 impl Sight {
-    fn new(frame: DepthFrame) -> Self {
-        let depth = frame.image().depth();
-        let measured = depth.iter().filter(|z| z.is_finite() && **z > 0.0).count();
-        let coverage = measured as f64 / depth.len().max(1) as f64;
-        Self { frame, coverage }
+    /// The depth image `frame` matched from the picture `reference` by a pair of quality
+    /// `quality` (`Q_ABD`): blind when the pair's quality is at least [`BLIND_QUALITY`] and
+    /// fewer than [`BLIND_SHARE`] of the picture's textured pixels (the texture test of
+    /// `matching`) got a depth. Shares of each image's own pixels are compared, since a
+    /// rectified pair's depth image need not have the picture's size. The texture test runs
+    /// only when the depth image holds a depth in fewer than [`BLIND_SHARE`] of all its
+    /// pixels; no picture with more can be blind.
+    fn new(frame: DepthFrame, quality: f64, reference: &GrayImage, matching: &MatchParams) -> Self {
+        let image = frame.image();
+        let pixels = image.depth().len();
+        let measured = (0..pixels).filter(|&i| image.has_depth(i)).count();
+        let coverage = measured as f64 / pixels.max(1) as f64;
+        let blind = quality >= BLIND_QUALITY && coverage < BLIND_SHARE && {
+            let flat = textureless(reference, matching);
+            let textured = flat.iter().filter(|&&f| !f).count();
+            coverage < BLIND_SHARE * textured as f64 / flat.len().max(1) as f64
+        };
+        Self { frame, blind }
     }
 }
 

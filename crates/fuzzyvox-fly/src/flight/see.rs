@@ -76,13 +76,19 @@ impl Flight<'_> {
             match result {
                 Ok(result) => {
                     let weight = result.reuse_weight();
+                    let quality = result.quality;
                     let mut depth = result.frame;
                     depth.scale_confidence(weight)?;
                     let t = Instant::now();
                     map.as_map_mut().integrate_depth(&depth, &self.options)?;
                     times.integrate_ms = ms(t);
                     self.log.depth_images += 1;
-                    self.sight = Some(Sight::new(depth));
+                    self.sight = Some(Sight::new(
+                        depth,
+                        quality,
+                        frame.image(),
+                        &self.params.matching,
+                    ));
                 }
                 Err(_) => self.log.depth_refused += 1,
             }

@@ -33,11 +33,19 @@ pub const VIEW_MARGIN: f64 = 0.1;
 /// Once the vehicle is that near, the depth stage no longer looks there.
 pub const NEAR_SHARE: f64 = 0.1;
 
-/// A depth image with fewer of its pixels holding a depth than this shows nothing: the camera
-/// is too near whatever fills its view for the depth stage to match it, or its view is blank.
-/// Every step into unknown space counts as heading at something within reach until a better
-/// picture comes.
+/// A depth image that holds a depth in fewer than this share of its picture's textured pixels
+/// is blind: the picture shows something, but the camera is too near it for the depth stage to
+/// match it. Every step into unknown space counts as heading at something within reach until a
+/// better picture comes. Texture-less pixels (the sky, a view that runs out of the scene) get
+/// no depth whatever their distance, so they do not count: a camera that looks at the sky is
+/// not blind.
 pub const BLIND_SHARE: f64 = 0.05;
+
+/// The least quality (`Q_ABD`, `fuzzyvox_depth::quality`) of the pair behind a depth image for
+/// [`BLIND_SHARE`] to apply. A pair whose baseline runs along the view (a step straight ahead
+/// or straight back) measures nothing around the epipole, the middle of its picture, whatever
+/// lies there: its lack of depth says nothing of what is near.
+pub const BLIND_QUALITY: f64 = 0.1;
 
 /// The share of those pixels that must hold a depth at all for [`NEAR_SHARE`] to apply (the
 /// sky holds none).
@@ -247,17 +255,16 @@ impl Flight<'_> {
     /// of any confidence counts: a camera flying straight at a surface puts it at the epipole
     /// of its motion, where the depth stage finds it but trusts it too little for the map, and
     /// once the vehicle is nearer than the least depth the stage looks for, no picture will
-    /// show it again. An image with depth in fewer than [`BLIND_SHARE`] of all its pixels is
-    /// blind, and counts as showing something everywhere. Reads the last depth image the
-    /// vehicle got (a picture taken where it held gives none); `false` before the first one
-    /// and when the direction lies outside it.
+    /// show it again. A blind image ([`BLIND_SHARE`]) counts as showing something everywhere.
+    /// Reads the last depth image the vehicle got (a picture taken where it held gives none);
+    /// `false` before the first one and when the direction lies outside it.
     fn near_ahead(&self, next: Point3<f64>) -> bool {
         let (Some(sight), Some(direction)) =
             (&self.sight, (next - self.position).try_normalize(1e-9))
         else {
             return false;
         };
-        if sight.coverage < BLIND_SHARE {
+        if sight.blind {
             return true;
         }
         let reach = self.config.min_depth + (next - self.position).norm();
@@ -284,10 +291,10 @@ impl Flight<'_> {
                     continue;
                 }
                 pixels += 1;
-                let z = depth[(y * w + x) as usize];
-                if z.is_finite() && z > 0.0 {
+                let index = (y * w + x) as usize;
+                if image.has_depth(index) {
                     measured += 1;
-                    near += usize::from(z < reach);
+                    near += usize::from(depth[index] < reach);
                 }
             }
         }
@@ -355,8 +362,10 @@ impl Flight<'_> {
 mod tests {
     #![allow(clippy::unwrap_used)]
 
+    use fuzzyvox_core::image::GrayImage;
     use fuzzyvox_core::integrate::{DepthFrame, IntervalDepthImage};
     use fuzzyvox_core::map::MapKind;
+    use fuzzyvox_depth::MatchParams;
     use fuzzyvox_sim::scenario;
     use fuzzyvox_sim::trajectory::look_at;
 
@@ -365,8 +374,15 @@ mod tests {
     use crate::flight::Sight;
 
     /// Whether a flight at `start`, looking along +x with a depth image whose pixels hold
-    /// `depth(column, row)`, finds something within reach of a step of 0.5 m along +x.
+    /// `depth(column, row)`, matched from a textured picture, finds something within reach of
+    /// a step of 0.5 m along +x.
     fn near_ahead_with(depth: impl Fn(u32, u32) -> f32) -> bool {
+        near_ahead_seeing(depth, true, 1.0)
+    }
+
+    /// [`near_ahead_with`] from a picture that is textured everywhere, or blank (one grey
+    /// level, as the sky) when `textured` is false, matched by a pair of quality `quality`.
+    fn near_ahead_seeing(depth: impl Fn(u32, u32) -> f32, textured: bool, quality: f64) -> bool {
         let scenario = scenario::wall().unwrap();
         let config = FlyConfig::default();
         let start = Point3::new(0.0, 0.0, 3.0);
@@ -384,7 +400,23 @@ mod tests {
         let confidence = vec![0.01; plane.len()];
         let image = IntervalDepthImage::new(w, h, near, plane, far, confidence).unwrap();
         let pose = look_at(start, Vector3::x());
-        flight.sight = Some(Sight::new(DepthFrame::new(k, pose, image).unwrap()));
+        let grey = (0..w * h)
+            .map(|i| {
+                if textured {
+                    0.2 + 0.6 * ((i.wrapping_mul(2_654_435_761) >> 7) % 101) as f32 / 100.0
+                } else {
+                    0.5
+                }
+            })
+            .collect();
+        let picture = GrayImage::new(w, h, grey).unwrap();
+        let depth = DepthFrame::new(k, pose, image).unwrap();
+        flight.sight = Some(Sight::new(
+            depth,
+            quality,
+            &picture,
+            &MatchParams::default(),
+        ));
         flight.near_ahead(start + Vector3::x() * 0.5)
     }
 
@@ -395,13 +427,18 @@ mod tests {
         assert!(near_ahead_with(|_, _| 1.2));
         // Far depth lets the step go on.
         assert!(!near_ahead_with(|_, _| 12.0));
-        // A picture with (almost) no depth anywhere is blind: refused.
+        // A textured picture with (almost) no depth anywhere is blind: refused.
         assert!(near_ahead_with(|_, _| f32::NAN));
         assert!(near_ahead_with(|x, y| if x == 0 && y == 0 {
             12.0
         } else {
             f32::NAN
         }));
+        // A blank one (the sky) is not: texture-less pixels get no depth at any distance.
+        assert!(!near_ahead_seeing(|_, _| f32::NAN, false, 1.0));
+        // Nor is one from a pair whose baseline runs along the view, which measures nothing
+        // around the middle of its picture whatever lies there.
+        assert!(!near_ahead_seeing(|_, _| f32::NAN, true, 0.05));
         // No depth straight ahead in a picture that has some elsewhere (the sky above the
         // ground) lets the step go on.
         let k = scenario::camera().unwrap();
