@@ -107,8 +107,14 @@ fn depth_from_pair_is_identical_for_1_2_and_8_threads() {
     // The maps built from those frames are identical too.
     let build = |threads: usize| -> Vec<Vec<u8>> {
         in_pool(threads, || {
+            // The fuzzy map with the default model, and with the one for checked depth (end
+            // points weighed by their image's rays).
+            let confirmed = FuzzyConfig::new(0.2)
+                .unwrap()
+                .with_evidence(fuzzyvox::EvidenceModel::confirmed());
             let mut maps = [
                 AnyMap::Fuzzy(FuzzyMap::new(FuzzyConfig::new(0.2).unwrap()).unwrap()),
+                AnyMap::Fuzzy(FuzzyMap::new(confirmed).unwrap()),
                 AnyMap::LogOdds(LogOddsMap::new(LogOddsConfig::new(0.2).unwrap()).unwrap()),
                 AnyMap::Alpha(AlphaCutMap::new(AlphaConfig::new(0.2).unwrap()).unwrap()),
             ];

@@ -286,3 +286,114 @@ fn voxels_over_unmeasured_pixels_read_their_footprint() {
         }
     }
 }
+
+/// A wall 3.02 m in front of a camera at the origin (0.05 m voxels, 400 px focal length, so
+/// each voxel of the wall holds some 40 pixels' end points), except the pixels `short`, whose
+/// depth came out 0.15 m short; every interval ±3%, confidence 0.9.
+fn wall_with_short_pixels(short: &[usize]) -> DepthFrame {
+    const W: u32 = 120;
+    let n = (W * W) as usize;
+    let mut depth = vec![3.02f32; n];
+    for &i in short {
+        depth[i] = 2.87;
+    }
+    let near = depth.iter().map(|d| d * 0.97).collect();
+    let far = depth.iter().map(|d| d * 1.03).collect();
+    let image = IntervalDepthImage::new(W, W, near, depth, far, vec![0.9; n]).unwrap();
+    let k = PinholeIntrinsics::new(W, W, 400.0, 400.0, 59.5, 59.5).unwrap();
+    DepthFrame::new(k, Isometry3::identity(), image).unwrap()
+}
+
+/// The occupied evidence one image gives the voxels of two points.
+fn occupied_at(model: EvidenceModel, frame: &DepthFrame, points: [Point3<f64>; 2]) -> [f32; 2] {
+    let resolution = Resolution::new(0.05).unwrap();
+    let (evidence, _) = depth_evidence(
+        frame,
+        &resolution,
+        &model,
+        &TConorm::default(),
+        &IntegrationOptions::default(),
+    )
+    .unwrap();
+    points.map(|p| {
+        let key = resolution.key_of(&p).unwrap();
+        evidence.cell(key).map_or(0.0, |e: &Evidence| e.occupied)
+    })
+}
+
+#[test]
+fn an_end_point_the_images_other_rays_pass_through_counts_little() {
+    // One pixel (u = 70, v = 60) came out 0.15 m short: its end point lies three voxels in
+    // front of the wall, in a voxel that its neighbours' rays cross on their way to the wall.
+    let pixel = 60 * 120 + 70;
+    let frame = wall_with_short_pixels(&[pixel]);
+    let lone = Point3::new(10.5 / 400.0 * 2.87, 0.5 / 400.0 * 2.87, 2.87);
+    let wall = Point3::new(10.5 / 400.0 * 3.02, 0.5 / 400.0 * 3.02, 3.02);
+    // Counted in full, the lone end point is as strong as the wall.
+    let [lone_full, wall_full] = occupied_at(EvidenceModel::dual(), &frame, [lone, wall]);
+    assert!(wall_full > 0.6, "{wall_full}");
+    assert_eq!(lone_full, wall_full);
+    // Weighed by the share of the image's rays that end there, it counts for little; the wall,
+    // where the rays end, keeps the full hit.
+    let confirmed = EvidenceModel::confirmed();
+    assert!(confirmed.end_point_share > 0.0);
+    let [lone_weighed, wall_weighed] = occupied_at(confirmed, &frame, [lone, wall]);
+    assert_eq!(wall_weighed, wall_full);
+    assert!(
+        lone_weighed < 0.2 * wall_weighed,
+        "{lone_weighed} {wall_weighed}"
+    );
+    // A whole patch of short pixels is a surface of its own: most rays through its voxel end
+    // there, so it keeps the full hit.
+    let patch: Vec<usize> = (50..70)
+        .flat_map(|v| (60..80).map(move |u| v * 120 + u))
+        .collect();
+    let frame = wall_with_short_pixels(&patch);
+    let [patch_weighed, _] = occupied_at(confirmed, &frame, [lone, wall]);
+    assert_eq!(patch_weighed, wall_full);
+}
+
+#[test]
+fn a_surface_seen_by_one_image_counts_less_than_one_seen_by_several() {
+    let mut once = map(EvidenceModel::confirmed());
+    let mut thrice = map(EvidenceModel::confirmed());
+    let frame = frame(2.95, 3.04, 3.13, 0.5, None);
+    once.integrate_depth(&frame, &IntegrationOptions::default())
+        .unwrap();
+    for _ in 0..3 {
+        thrice
+            .integrate_depth(&frame, &IntegrationOptions::default())
+            .unwrap();
+    }
+    let surface = Point3::new(-0.05, -0.05, 3.05);
+    let (one, three) = (
+        once.memberships_at_point(&surface).unwrap(),
+        thrice.memberships_at_point(&surface).unwrap(),
+    );
+    assert!(
+        one.occupied > 0.0 && three.occupied > one.occupied,
+        "{one:?} {three:?}"
+    );
+    // One image of confidence 0.5 does not make the voxel occupied; three do.
+    let class = |m: &FuzzyMap| m.class_at_point(&surface).unwrap();
+    assert_ne!(class(&once), fuzzyvox::VoxelClass::Occupied);
+    assert_eq!(class(&thrice), fuzzyvox::VoxelClass::Occupied);
+}
+
+#[test]
+fn an_end_point_share_outside_zero_to_one_is_refused() {
+    for share in [-0.1, 1.5, f32::NAN] {
+        let model = EvidenceModel {
+            end_point_share: share,
+            ..EvidenceModel::confirmed()
+        };
+        assert!(model.validate().is_err(), "{share}");
+        assert!(
+            FuzzyConfig::new(RES)
+                .unwrap()
+                .with_evidence(model)
+                .validate()
+                .is_err()
+        );
+    }
+}

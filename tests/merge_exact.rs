@@ -9,7 +9,9 @@ mod common;
 use common::{data_dir, room_scan};
 use fuzzyvox::io::read_text_cloud;
 use fuzzyvox::io::rgbd::RgbdFolder;
-use fuzzyvox::{DepthFrame, FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMapMut};
+use fuzzyvox::{
+    DepthFrame, EvidenceModel, FuzzyConfig, FuzzyMap, IntegrationOptions, PointCloud, VoxelMapMut,
+};
 use nalgebra::Point3;
 
 fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
@@ -122,9 +124,18 @@ fn octomap_scan_in_eight_parts_gives_identical_files_in_any_order() {
     assert_exact(&parts, 0.1, "product");
 }
 
+/// An empty map at 0.05 m with the evidence model `model`.
+fn empty_with(model: EvidenceModel) -> FuzzyMap {
+    FuzzyMap::new(FuzzyConfig::new(0.05).unwrap().with_evidence(model)).unwrap()
+}
+
 /// A map of the frames `range` of the folder.
-fn frames_map(frames: &[DepthFrame], range: std::ops::Range<usize>) -> FuzzyMap {
-    let mut map = empty(0.05, "product");
+fn frames_map(
+    frames: &[DepthFrame],
+    range: std::ops::Range<usize>,
+    model: EvidenceModel,
+) -> FuzzyMap {
+    let mut map = empty_with(model);
     for frame in &frames[range] {
         map.integrate_depth(frame, &IntegrationOptions::default())
             .unwrap();
@@ -147,27 +158,31 @@ fn rgbd_partial_maps_merge_to_identical_files_in_any_tree() {
     let frames: Vec<DepthFrame> = (0..50)
         .map(|i| folder.read_kinect_frame(i).unwrap())
         .collect();
-    let serial = frames_map(&frames, 0..50).to_bytes();
-    // Five partial maps of ten frames each, merged in three different trees.
-    let parts: Vec<FuzzyMap> = (0..5)
-        .map(|i| frames_map(&frames, i * 10..i * 10 + 10))
-        .collect();
-    let chain = parts[1..].iter().fold(parts[0].clone(), merged);
-    let balanced = merged(
-        merged(parts[0].clone(), &parts[1]),
-        &merged(parts[2].clone(), &merged(parts[3].clone(), &parts[4])),
-    );
-    let backwards = parts[..4].iter().rev().fold(parts[4].clone(), merged);
-    assert_eq!(chain.to_bytes(), serial, "chain");
-    assert_eq!(balanced.to_bytes(), serial, "balanced tree");
-    assert_eq!(backwards.to_bytes(), serial, "backwards chain");
-    // Uneven parts: odd frames and even frames.
-    let mut odd = empty(0.05, "product");
-    let mut even = empty(0.05, "product");
-    for (i, frame) in frames.iter().enumerate() {
-        let map = if i % 2 == 0 { &mut even } else { &mut odd };
-        map.integrate_depth(frame, &IntegrationOptions::default())
-            .unwrap();
+    // The default model, and the one for checked depth, whose end points are weighed by the
+    // rays of their own image.
+    for model in [EvidenceModel::default(), EvidenceModel::confirmed()] {
+        let serial = frames_map(&frames, 0..50, model).to_bytes();
+        // Five partial maps of ten frames each, merged in three different trees.
+        let parts: Vec<FuzzyMap> = (0..5)
+            .map(|i| frames_map(&frames, i * 10..i * 10 + 10, model))
+            .collect();
+        let chain = parts[1..].iter().fold(parts[0].clone(), merged);
+        let balanced = merged(
+            merged(parts[0].clone(), &parts[1]),
+            &merged(parts[2].clone(), &merged(parts[3].clone(), &parts[4])),
+        );
+        let backwards = parts[..4].iter().rev().fold(parts[4].clone(), merged);
+        assert_eq!(chain.to_bytes(), serial, "chain");
+        assert_eq!(balanced.to_bytes(), serial, "balanced tree");
+        assert_eq!(backwards.to_bytes(), serial, "backwards chain");
+        // Uneven parts: odd frames and even frames.
+        let mut odd = empty_with(model);
+        let mut even = empty_with(model);
+        for (i, frame) in frames.iter().enumerate() {
+            let map = if i % 2 == 0 { &mut even } else { &mut odd };
+            map.integrate_depth(frame, &IntegrationOptions::default())
+                .unwrap();
+        }
+        assert_eq!(merged(odd, &even).to_bytes(), serial, "odd and even frames");
     }
-    assert_eq!(merged(odd, &even).to_bytes(), serial, "odd and even frames");
 }

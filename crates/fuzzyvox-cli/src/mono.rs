@@ -78,7 +78,7 @@ pub struct MonoArgs {
     #[arg(long, default_value_t = 4, value_name = "N")]
     consistency: usize,
     /// Neighbouring depth images that must agree with a pixel for it to keep its depth.
-    #[arg(long, default_value_t = 2, value_name = "K")]
+    #[arg(long, default_value_t = 1, value_name = "K")]
     min_agreeing: usize,
     /// Poses from a TUM trajectory (`timestamp tx ty tz qx qy qz qw` per line, the k-th pose
     /// for the k-th frame) instead of `frame-N.pose.txt`.

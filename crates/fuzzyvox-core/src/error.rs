@@ -155,7 +155,7 @@ pub enum FormatError {
     #[error("not a fuzzyvox map file (bad magic bytes)")]
     BadMagic,
     /// The file was written by a newer, unknown format version.
-    #[error("unsupported format version {0} (this fuzzyvox reads versions 1 and 2)")]
+    #[error("unsupported format version {0} (this fuzzyvox reads versions 1 to 5)")]
     UnsupportedVersion(u16),
     /// The file holds another kind of map than the one requested.
     #[error("the file holds a {found} map, not a {expected} map")]

@@ -29,7 +29,11 @@ pub struct ConsistencyParams {
     /// the neighbour's camera and the neighbour's own depth there differ by at most this
     /// fraction of the carried depth.
     pub tolerance: f32,
-    /// Agreeing neighbours a pixel needs to keep its depth.
+    /// Agreeing neighbours a pixel needs to keep its depth. Default 1: a pixel that no
+    /// neighbour confirms is dropped; a confirmed one keeps a confidence scaled by the share of
+    /// voting neighbours that agree. On the shared HoloLens frames (0.05 m, four windows) 1
+    /// rather than 2 keeps 29-60% more depth and lifts the fuzzy map's `within_2_voxels` by
+    /// 0.007-0.045 (the log-odds map's falls by 0.01-0.06: it counts every kept depth alike).
     pub min_agreeing: usize,
     /// Smallest half-width of a kept pixel's interval, as a fraction of its depth: `[P-, P+]`
     /// is widened to at least `P0 · (1 ± floor)`. Depths within the tolerance count as the same
@@ -50,7 +54,7 @@ impl Default for ConsistencyParams {
         Self {
             neighbours: 4,
             tolerance: 0.03,
-            min_agreeing: 2,
+            min_agreeing: 1,
             interval_floor: 0.05,
             search_far: None,
         }
@@ -389,13 +393,13 @@ mod tests {
         let twin = frame(0.0, &[centre]);
         let others = [frame(-0.1, &[]), frame(0.1, &[])];
         let neighbours = [&twin, &others[0], &others[1]];
-        let strict = ConsistencyParams::default();
+        let strict = ConsistencyParams {
+            min_agreeing: 2,
+            ..ConsistencyParams::default()
+        };
         let (checked, _) = check_consistency(&target, &neighbours, &strict).unwrap();
         assert!(checked.image().depth()[centre].is_nan());
-        let lenient = ConsistencyParams {
-            min_agreeing: 1,
-            ..strict
-        };
+        let lenient = ConsistencyParams::default();
         let (checked, votes) = check_consistency(&target, &neighbours, &lenient).unwrap();
         assert_eq!(
             (votes.agreeing[centre], votes.seeing_through[centre]),

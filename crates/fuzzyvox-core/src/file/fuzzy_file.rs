@@ -3,32 +3,82 @@ use serde::{Deserialize, Serialize};
 use super::mapfile;
 use super::stored_blocks::{self, PackedStoredBlock, StoredBlock};
 use crate::error::{FormatError, Result};
-use crate::integrate::EvidenceModel;
+use crate::integrate::{EvidenceKind, EvidenceModel};
 use crate::map::MapKind;
 use crate::map::{Accumulator, FuzzyConfig, FuzzyMap, Levels};
 use crate::measures::{MeasureConfig, Memberships};
 use crate::ops::TConorm;
 use crate::storage::Resolution;
 
-/// A format version 3 body: memberships as levels of the operator's generator, 512 per block.
+/// A format version 5 body: the settings with the evidence model's end-point share, each
+/// block's distinct levels and cell codes.
 #[derive(Serialize, Deserialize)]
-struct Body {
+struct BodyV5 {
     config: FuzzyConfig,
-    blocks: Vec<StoredBlock<Levels>>,
+    blocks: Vec<PackedStoredBlock<Levels>>,
 }
 
 /// A format version 4 body: levels as version 3, each block's distinct values and cell codes.
 #[derive(Serialize, Deserialize)]
 struct BodyV4 {
-    config: FuzzyConfig,
+    config: ConfigV4,
     blocks: Vec<PackedStoredBlock<Levels>>,
+}
+
+/// A format version 3 body: memberships as levels of the operator's generator, 512 per block.
+#[derive(Serialize, Deserialize)]
+struct BodyV3 {
+    config: ConfigV4,
+    blocks: Vec<StoredBlock<Levels>>,
 }
 
 /// A format version 2 body: memberships as `f32`.
 #[derive(Serialize, Deserialize)]
 struct BodyV2 {
-    config: FuzzyConfig,
+    config: ConfigV4,
     blocks: Vec<StoredBlock<Memberships>>,
+}
+
+/// The settings as versions 2 to 4 stored them: the evidence model had no end-point share (end
+/// points counted in full).
+#[derive(Clone, Copy, Serialize, Deserialize)]
+struct ConfigV4 {
+    resolution: Resolution,
+    operator: TConorm,
+    evidence: EvidenceV4,
+    measures: MeasureConfig,
+}
+
+#[derive(Clone, Copy, Serialize, Deserialize)]
+struct EvidenceV4 {
+    kind: EvidenceKind,
+    occupied_gain: f32,
+    free_gain: f32,
+    angular_resolution: f64,
+    interval_falloff: f32,
+    free_reach: f32,
+    fill_footprints: bool,
+}
+
+impl From<ConfigV4> for FuzzyConfig {
+    fn from(old: ConfigV4) -> Self {
+        let e = old.evidence;
+        FuzzyConfig {
+            resolution: old.resolution,
+            operator: old.operator,
+            evidence: EvidenceModel {
+                kind: e.kind,
+                occupied_gain: e.occupied_gain,
+                free_gain: e.free_gain,
+                angular_resolution: e.angular_resolution,
+                interval_falloff: e.interval_falloff,
+                free_reach: e.free_reach,
+                fill_footprints: e.fill_footprints,
+                end_point_share: 0.0,
+            },
+            measures: old.measures,
+        }
+    }
 }
 
 /// A format version 1 body: its evidence model had no kind (it was the paper's model) and no
@@ -58,16 +108,19 @@ struct EvidenceV1 {
 impl From<BodyV1> for BodyV2 {
     fn from(old: BodyV1) -> Self {
         let e = old.config.evidence;
+        let paper = EvidenceModel::paper();
         BodyV2 {
-            config: FuzzyConfig {
+            config: ConfigV4 {
                 resolution: old.config.resolution,
                 operator: old.config.operator,
-                evidence: EvidenceModel {
+                evidence: EvidenceV4 {
+                    kind: paper.kind,
                     occupied_gain: e.occupied_gain,
                     free_gain: e.free_gain,
                     angular_resolution: e.angular_resolution,
                     interval_falloff: e.interval_falloff,
-                    ..EvidenceModel::paper()
+                    free_reach: paper.free_reach,
+                    fill_footprints: paper.fill_footprints,
                 },
                 measures: old.config.measures,
             },
@@ -87,7 +140,7 @@ impl FuzzyMap {
             MapKind::Fuzzy,
             Some(config.operator.family()),
             config.resolution.size(),
-            &BodyV4 {
+            &BodyV5 {
                 config,
                 blocks: stored_blocks::store_packed(self.grid()),
             },
@@ -106,7 +159,7 @@ impl FuzzyMap {
             2 => Some(postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?),
             _ => None,
         };
-        let body: Body = match old {
+        let (config, blocks): (FuzzyConfig, Vec<StoredBlock<Levels>>) = match old {
             Some(old) => {
                 // Memberships before version 3: every one becomes the nearest level.
                 let unit = |v: f32| (0.0..=1.0).contains(&v);
@@ -121,29 +174,36 @@ impl FuzzyMap {
                     )));
                 }
                 let acc = Accumulator::new(old.config.operator);
-                Body {
-                    config: old.config,
-                    blocks: old
-                        .blocks
-                        .into_iter()
-                        .map(|b| StoredBlock {
-                            key: b.key,
-                            cells: b.cells.iter().map(|m| acc.levels(*m)).collect(),
-                        })
-                        .collect(),
-                }
+                let blocks = old
+                    .blocks
+                    .into_iter()
+                    .map(|b| StoredBlock {
+                        key: b.key,
+                        cells: b.cells.iter().map(|m| acc.levels(*m)).collect(),
+                    })
+                    .collect();
+                (old.config.into(), blocks)
             }
-            None if header.version >= 4 => {
+            None if header.version >= 5 => {
+                let body: BodyV5 =
+                    postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
+                (body.config, stored_blocks::unpack_stored(body.blocks)?)
+            }
+            None if header.version == 4 => {
                 let body: BodyV4 =
                     postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
-                Body {
-                    config: body.config,
-                    blocks: stored_blocks::unpack_stored(body.blocks)?,
-                }
+                (
+                    body.config.into(),
+                    stored_blocks::unpack_stored(body.blocks)?,
+                )
             }
-            None => postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?,
+            None => {
+                let body: BodyV3 =
+                    postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
+                (body.config.into(), body.blocks)
+            }
         };
-        let config = body.config.validate().map_err(|e| invalid(e.to_string()))?;
+        let config = config.validate().map_err(|e| invalid(e.to_string()))?;
         if header.resolution != config.resolution.size()
             || header.operator != Some(config.operator.family())
         {
@@ -151,7 +211,7 @@ impl FuzzyMap {
         }
         // Every level must be one the operator's accumulator can produce.
         let acc = Accumulator::new(config.operator);
-        let grid = stored_blocks::restore(body.blocks, |l: &Levels| {
+        let grid = stored_blocks::restore(blocks, |l: &Levels| {
             acc.is_valid(l.occupied) && acc.is_valid(l.free)
         })?;
         Ok(FuzzyMap::from_parts(config, grid))
@@ -161,7 +221,25 @@ impl FuzzyMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::EvidenceKind;
+
+    /// `config` as versions 2 to 4 stored it (the end-point share left out).
+    fn config_v4(config: FuzzyConfig) -> ConfigV4 {
+        let e = config.evidence;
+        ConfigV4 {
+            resolution: config.resolution,
+            operator: config.operator,
+            evidence: EvidenceV4 {
+                kind: e.kind,
+                occupied_gain: e.occupied_gain,
+                free_gain: e.free_gain,
+                angular_resolution: e.angular_resolution,
+                interval_falloff: e.interval_falloff,
+                free_reach: e.free_reach,
+                fill_footprints: e.fill_footprints,
+            },
+            measures: config.measures,
+        }
+    }
 
     /// The map's memberships as a version 1 or 2 file stored them.
     fn memberships_grid(map: &FuzzyMap) -> crate::storage::BlockGrid<Memberships> {
@@ -219,10 +297,10 @@ mod tests {
             crate::map::VoxelMap::memberships_at(&map, key)
         );
         // A version from the future is refused with its number.
-        bytes[8..10].copy_from_slice(&5u16.to_le_bytes());
+        bytes[8..10].copy_from_slice(&6u16.to_le_bytes());
         assert!(matches!(
             FuzzyMap::decode(&bytes),
-            Err(FormatError::UnsupportedVersion(5))
+            Err(FormatError::UnsupportedVersion(6))
         ));
     }
 
@@ -244,8 +322,8 @@ mod tests {
             MapKind::Fuzzy,
             Some(config.operator.family()),
             0.2,
-            &Body {
-                config,
+            &BodyV3 {
+                config: config_v4(config),
                 blocks: stored_blocks::store(map.grid()),
             },
         );
@@ -259,5 +337,41 @@ mod tests {
             map.to_bytes().len(),
             v3.len()
         );
+    }
+
+    /// A version 4 file (no end-point share in its evidence model) loads as the map it was
+    /// written from, its end points unweighed; the share survives a save and a load.
+    #[test]
+    fn version_4_files_load_with_end_points_unweighed() {
+        let config = FuzzyConfig::new(0.2)
+            .unwrap()
+            .with_evidence(EvidenceModel::confirmed());
+        let mut map = FuzzyMap::new(config).unwrap();
+        let cloud = crate::integrate::PointCloud::new(
+            nalgebra::Point3::origin(),
+            vec![nalgebra::Point3::new(1.5, 0.3, 0.1)],
+        )
+        .unwrap();
+        crate::map::VoxelMapMut::integrate_cloud(&mut map, &cloud, &Default::default()).unwrap();
+        let v4 = mapfile::encode(
+            MapKind::Fuzzy,
+            Some(config.operator.family()),
+            0.2,
+            &BodyV4 {
+                config: config_v4(config),
+                blocks: stored_blocks::store_packed(map.grid()),
+            },
+        );
+        let v4 = mapfile::with_version(v4, 4);
+        let loaded = FuzzyMap::decode(&v4).unwrap();
+        assert_eq!(loaded.config().evidence.end_point_share, 0.0);
+        assert_eq!(
+            loaded.config().evidence.free_gain,
+            config.evidence.free_gain
+        );
+        assert_eq!(loaded.grid().cells().count(), map.grid().cells().count());
+        let again = FuzzyMap::decode(&map.to_bytes()).unwrap();
+        assert_eq!(again.config().evidence.end_point_share, 1.0 / 3.0);
+        assert_eq!(again.to_bytes(), map.to_bytes());
     }
 }

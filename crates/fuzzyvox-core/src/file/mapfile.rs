@@ -5,7 +5,7 @@
 //! | bytes | field |
 //! |---|---|
 //! | 0..8 | magic `FUZZYVOX` |
-//! | 8..10 | format version (4; 1 to 3 are still read) |
+//! | 8..10 | format version (5; 1 to 4 are still read) |
 //! | 10 | map kind (1 fuzzy, 2 log-odds, 3 alpha-cut) |
 //! | 11 | operator family code (255: none) |
 //! | 12..20 | operator parameter (f64; 0 when the family has none) |
@@ -25,7 +25,7 @@ use crate::ops::Family;
 
 /// The first eight bytes of every native map file.
 pub const MAGIC: &[u8; 8] = b"FUZZYVOX";
-const VERSION: u16 = 4;
+const VERSION: u16 = 5;
 /// The oldest version still read. Version 2 added the evidence model's kind and free reach to
 /// fuzzy maps' settings; a version 1 fuzzy map was built with the paper's model and loads as
 /// such. Version 3 stores a fuzzy map's memberships as levels of its operator's generator
@@ -33,6 +33,8 @@ const VERSION: u16 = 4;
 /// converted to the nearest levels as it loads. Log-odds and alpha-cut bodies are the same in
 /// versions 1 to 3. Version 4 stores each block's distinct values once and each cell's index
 /// among them in the fewest bits (`stored_blocks::PackedStoredBlock`) instead of 512 cells.
+/// Version 5 adds the evidence model's end-point share to fuzzy maps' settings (a version 4
+/// fuzzy map loads with end points unweighed); other bodies are as in version 4.
 const OLDEST_VERSION: u16 = 1;
 const HEADER_LEN: usize = 40;
 const NO_OPERATOR: u8 = 255;

@@ -1,7 +1,10 @@
-//! End points: the voxel of each pixel's most likely surface point gets the full evidence of a
-//! hit, as in the point integrator.
+//! End points: the voxel of each pixel's most likely surface point gets the evidence of a hit,
+//! in full as in the point integrator, or weighed by the share of the image's rays that end
+//! there ([`EvidenceModel::end_point_share`]).
 
+use nalgebra::Vector3;
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::pixel::PixelEvidence;
 use crate::integrate::depth_image::DepthFrame;
@@ -29,6 +32,10 @@ pub(super) fn mark_end_points(
     model: &EvidenceModel,
     operator: &TConorm,
 ) {
+    if model.end_point_share > 0.0 {
+        mark_weighed_end_points(evidence, frame, pixels, resolution, model, operator);
+        return;
+    }
     let k = frame.intrinsics();
     let pose = frame.world_from_camera();
     let width = k.width() as usize;
@@ -64,5 +71,98 @@ pub(super) fn mark_end_points(
     for (key, hit) in rows.iter().flatten() {
         let cell = cells.get_or_insert(*key);
         cell.occupied = cell.occupied.max(*hit);
+    }
+}
+
+/// One image's rays at one voxel: how many end in it, how many pass through it on their last
+/// [`EvidenceModel::PASS_VOXELS`] voxels, and the highest confidence of those that end.
+#[derive(Clone, Copy, Default)]
+struct RayTally {
+    ends: u32,
+    passes: u32,
+    confidence: f32,
+}
+
+/// [`mark_end_points`] with each hit weighed by the share `s` of the image's rays through its
+/// voxel that end there: the hit is `k_O · min(1, s / end_point_share)` weighted by the highest
+/// confidence among them. A ray passes through the voxels it crosses within
+/// [`EvidenceModel::PASS_VOXELS`] voxels in front of its own end point (sampled every third of
+/// a voxel along the depth). Counts are sums and confidences maxima, so the order of pixels
+/// and rows does not matter.
+fn mark_weighed_end_points(
+    evidence: &mut ScanEvidence,
+    frame: &DepthFrame,
+    pixels: &[PixelEvidence],
+    resolution: &Resolution,
+    model: &EvidenceModel,
+    operator: &TConorm,
+) {
+    let k = frame.intrinsics();
+    let pose = frame.world_from_camera();
+    let origin = pose.translation.vector;
+    let width = k.width() as usize;
+    let size = resolution.size() as f32;
+    let step = size / 3.0;
+    let samples = (EvidenceModel::PASS_VOXELS * 3.0) as u32;
+    let rows: Vec<Vec<(VoxelKey, bool, f32)>> = pixels
+        .par_chunks(width.max(1))
+        .enumerate()
+        .map(|(v, row)| {
+            let mut rays = Vec::new();
+            for (u, p) in row.iter().enumerate() {
+                if !p.is_valid() || p.height <= 0.0 {
+                    continue;
+                }
+                // The ray through the pixel, per metre of depth along the optical axis.
+                let along = pose.rotation
+                    * Vector3::new(
+                        (u as f64 - k.cx()) / k.fx(),
+                        (v as f64 - k.cy()) / k.fy(),
+                        1.0,
+                    );
+                let at = |depth: f32| (origin + along * f64::from(depth)).into();
+                // A point outside the key range was already refused by the frustum box; skip it.
+                let Ok(end) = resolution.key_of(&at(p.depth)) else {
+                    continue;
+                };
+                rays.push((end, true, p.confidence));
+                let mut last = end;
+                for j in 1..=samples {
+                    let depth = p.depth - j as f32 * step;
+                    if depth <= 0.0 {
+                        break;
+                    }
+                    let Ok(key) = resolution.key_of(&at(depth)) else {
+                        break;
+                    };
+                    if key != last && key != end {
+                        rays.push((key, false, 0.0));
+                        last = key;
+                    }
+                }
+            }
+            rays
+        })
+        .collect();
+    let mut tally: FxHashMap<VoxelKey, RayTally> = FxHashMap::default();
+    for &(key, ends, confidence) in rows.iter().flatten() {
+        let t = tally.entry(key).or_default();
+        if ends {
+            t.ends += 1;
+            t.confidence = t.confidence.max(confidence);
+        } else {
+            t.passes += 1;
+        }
+    }
+    let mut cells = AccessorMut::new(evidence);
+    for (key, t) in tally {
+        if t.ends == 0 {
+            continue;
+        }
+        let share = t.ends as f32 / (t.ends + t.passes) as f32;
+        let weight = (share / model.end_point_share).min(1.0);
+        let hit = model.occupied(operator, t.confidence, weight);
+        let cell = cells.get_or_insert(key);
+        cell.occupied = cell.occupied.max(hit);
     }
 }
