@@ -100,13 +100,13 @@ fn map_of_another_kind_is_wrong_kind() {
 #[test]
 fn map_of_a_newer_version_is_unsupported() {
     let mut bytes = fuzzy_map().to_bytes();
-    bytes[8..10].copy_from_slice(&5u16.to_le_bytes());
+    bytes[8..10].copy_from_slice(&6u16.to_le_bytes());
     // Version is checked before the CRC, so no repair is needed; repair anyway to be sure it is
     // the version that is refused.
     repair(&mut bytes);
     assert_eq!(
         format_reason(FuzzyMap::from_bytes(&bytes)),
-        FormatError::UnsupportedVersion(5)
+        FormatError::UnsupportedVersion(6)
     );
 }
 
