@@ -128,17 +128,22 @@ fn free_membership_falls_monotonically_through_the_interval() {
     assert!(paper.iter().all(|(z, m)| *z < 3.0 - DELTA || m.free == 0.0));
 }
 
+/// The evidence one frame gives the voxels of a map at `resolution`, before the map folds it in.
+fn scan_evidence(
+    model: EvidenceModel,
+    frame: &DepthFrame,
+    resolution: &Resolution,
+) -> fuzzyvox::ScanEvidence {
+    let options = IntegrationOptions::default();
+    depth_evidence(frame, resolution, &model, &TConorm::default(), &options)
+        .unwrap()
+        .0
+}
+
 /// The evidence one frame gives the voxels beside the optical axis, before the map folds it in.
 fn evidence_along_axis(model: EvidenceModel, frame: &DepthFrame) -> Vec<(f64, Evidence)> {
     let resolution = Resolution::new(RES).unwrap();
-    let (scan, _) = depth_evidence(
-        frame,
-        &resolution,
-        &model,
-        &TConorm::default(),
-        &IntegrationOptions::default(),
-    )
-    .unwrap();
+    let scan = scan_evidence(model, frame, &resolution);
     (1..120)
         .map(|k| {
             let centre = Point3::new(-0.05, -0.05, (f64::from(k) + 0.5) * RES);
@@ -307,14 +312,7 @@ fn wall_with_short_pixels(short: &[usize]) -> DepthFrame {
 /// The occupied evidence one image gives the voxels of two points.
 fn occupied_at(model: EvidenceModel, frame: &DepthFrame, points: [Point3<f64>; 2]) -> [f32; 2] {
     let resolution = Resolution::new(0.05).unwrap();
-    let (evidence, _) = depth_evidence(
-        frame,
-        &resolution,
-        &model,
-        &TConorm::default(),
-        &IntegrationOptions::default(),
-    )
-    .unwrap();
+    let evidence = scan_evidence(model, frame, &resolution);
     points.map(|p| {
         let key = resolution.key_of(&p).unwrap();
         evidence.cell(key).map_or(0.0, |e: &Evidence| e.occupied)

@@ -105,26 +105,20 @@ struct EvidenceV1 {
     interval_falloff: f32,
 }
 
-impl From<BodyV1> for BodyV2 {
-    fn from(old: BodyV1) -> Self {
-        let e = old.config.evidence;
-        let paper = EvidenceModel::paper();
-        BodyV2 {
-            config: ConfigV4 {
-                resolution: old.config.resolution,
-                operator: old.config.operator,
-                evidence: EvidenceV4 {
-                    kind: paper.kind,
-                    occupied_gain: e.occupied_gain,
-                    free_gain: e.free_gain,
-                    angular_resolution: e.angular_resolution,
-                    interval_falloff: e.interval_falloff,
-                    free_reach: paper.free_reach,
-                    fill_footprints: paper.fill_footprints,
-                },
-                measures: old.config.measures,
+impl From<ConfigV1> for FuzzyConfig {
+    fn from(old: ConfigV1) -> Self {
+        let e = old.evidence;
+        FuzzyConfig {
+            resolution: old.resolution,
+            operator: old.operator,
+            evidence: EvidenceModel {
+                occupied_gain: e.occupied_gain,
+                free_gain: e.free_gain,
+                angular_resolution: e.angular_resolution,
+                interval_falloff: e.interval_falloff,
+                ..EvidenceModel::paper()
             },
-            blocks: old.blocks,
+            measures: old.measures,
         }
     }
 }
@@ -150,20 +144,23 @@ impl FuzzyMap {
     fn decode(bytes: &[u8]) -> Result<Self, FormatError> {
         let (header, body) = mapfile::body_of(bytes, MapKind::Fuzzy)?;
         let invalid = FormatError::Invalid;
-        let old: Option<BodyV2> = match header.version {
-            1 => Some(
-                postcard::from_bytes::<BodyV1>(body)
-                    .map_err(|e| invalid(e.to_string()))?
-                    .into(),
-            ),
-            2 => Some(postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?),
+        // Versions 1 and 2 store memberships: their settings and blocks.
+        let old: Option<(FuzzyConfig, Vec<StoredBlock<Memberships>>)> = match header.version {
+            1 => {
+                let old: BodyV1 = postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
+                Some((old.config.into(), old.blocks))
+            }
+            2 => {
+                let old: BodyV2 = postcard::from_bytes(body).map_err(|e| invalid(e.to_string()))?;
+                Some((old.config.into(), old.blocks))
+            }
             _ => None,
         };
         let (config, blocks): (FuzzyConfig, Vec<StoredBlock<Levels>>) = match old {
-            Some(old) => {
+            Some((config, old_blocks)) => {
                 // Memberships before version 3: every one becomes the nearest level.
                 let unit = |v: f32| (0.0..=1.0).contains(&v);
-                if let Some(bad) = old.blocks.iter().find(|b| {
+                if let Some(bad) = old_blocks.iter().find(|b| {
                     !b.cells
                         .iter()
                         .all(|m: &Memberships| unit(m.occupied) && unit(m.free))
@@ -173,16 +170,15 @@ impl FuzzyMap {
                         bad.key
                     )));
                 }
-                let acc = Accumulator::new(old.config.operator);
-                let blocks = old
-                    .blocks
+                let acc = Accumulator::new(config.operator);
+                let blocks = old_blocks
                     .into_iter()
                     .map(|b| StoredBlock {
                         key: b.key,
                         cells: b.cells.iter().map(|m| acc.levels(*m)).collect(),
                     })
                     .collect();
-                (old.config.into(), blocks)
+                (config, blocks)
             }
             None if header.version >= 5 => {
                 let body: BodyV5 =

@@ -101,9 +101,10 @@ fn mark_weighed_end_points(
     let pose = frame.world_from_camera();
     let origin = pose.translation.vector;
     let width = k.width() as usize;
-    let size = resolution.size() as f32;
-    let step = size / 3.0;
-    let samples = (EvidenceModel::PASS_VOXELS * 3.0) as u32;
+    // Samples per voxel of depth in front of an end point.
+    const PER_VOXEL: f32 = 3.0;
+    let step = resolution.size() as f32 / PER_VOXEL;
+    let samples = (EvidenceModel::PASS_VOXELS * PER_VOXEL) as u32;
     let rows: Vec<Vec<(VoxelKey, bool, f32)>> = pixels
         .par_chunks(width.max(1))
         .enumerate()
