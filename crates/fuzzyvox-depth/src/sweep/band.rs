@@ -188,8 +188,11 @@ fuzzyvox_core::dispatched! {
         for (r, row) in exclusion.chunks_exact_mut(width).enumerate() {
             sweep.exclusions(rays.row(y0 - first + r), row);
         }
-        let (mut best, mut best_plane, mut run_end) = (vec![u16::MAX; n], vec![0u32; n], vec![0u32; n]);
-        let (mut left, mut right) = (vec![u16::MAX; n], vec![u16::MAX; n]);
+        // Every lane is 32 bits wide, costs too (`NONE` for none yet), so that a vector holds
+        // the same pixels in every array.
+        const NONE: u32 = u16::MAX as u32;
+        let (mut best, mut best_plane, mut run_end) = (vec![NONE; n], vec![0u32; n], vec![0u32; n]);
+        let (mut left, mut right) = (vec![NONE; n], vec![NONE; n]);
         // Pass 1: the best run of planes and the costs on either side of it.
         let mut previous = vec![u16::MAX; n];
         for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
@@ -205,17 +208,21 @@ fuzzyvox_core::dispatched! {
                 // A new best starts a run; the plane right after the run either extends it (an
                 // equal cost, when a plane is less than a pixel of motion) or gives its right-hand
                 // cost.
+                let (c, p) = (u32::from(c), u32::from(p));
                 let new_best = c < *best;
-                let next = !new_best && k == *run_end + 1 && *best != u16::MAX && *right == u16::MAX;
-                let extend = next && c == *best && exclusion > 1;
+                let next = !new_best
+                    & (k == run_end.wrapping_add(1))
+                    & (*best != NONE)
+                    & (*right == NONE);
+                let extend = next & (c == *best) & (exclusion > 1);
                 *right = if new_best {
-                    u16::MAX
-                } else if next && !extend {
+                    NONE
+                } else if next & !extend {
                     c
                 } else {
                     *right
                 };
-                *run_end = if new_best || extend { k } else { *run_end };
+                *run_end = if new_best | extend { k } else { *run_end };
                 *best_plane = if new_best { k } else { *best_plane };
                 *left = if new_best { p } else { *left };
                 *best = if new_best { c } else { *best };
@@ -225,11 +232,11 @@ fuzzyvox_core::dispatched! {
         // Pass 2: the best cost more than one pixel of motion beyond the run, and the cost-curve
         // range.
         let tolerance = 1.0 + f64::from(params.range_tolerance);
-        let limits: Vec<u16> = best
+        let limits: Vec<u32> = best
             .iter()
-            .map(|&b| (f64::from(b) * tolerance).min(f64::from(u16::MAX - 1)) as u16)
+            .map(|&b| (f64::from(b) * tolerance).min(f64::from(u16::MAX - 1)) as u32)
             .collect();
-        let (mut runner_up, mut low, mut high) = (vec![u16::MAX; n], vec![u32::MAX; n], vec![0u32; n]);
+        let (mut runner_up, mut low, mut high) = (vec![NONE; n], vec![u32::MAX; n], vec![0u32; n]);
         for (k, costs) in (0..sweep.planes).zip(volume.chunks_exact(n)) {
             let lanes = runner_up
                 .iter_mut()
@@ -241,6 +248,7 @@ fuzzyvox_core::dispatched! {
             for (((((runner_up, low), high), (&best_plane, &run_end)), (&exclusion, &limit)), &c) in
                 lanes
             {
+                let c = u32::from(c);
                 let beyond = best_plane.saturating_sub(k).max(k.saturating_sub(run_end)) > exclusion;
                 *runner_up = if beyond {
                     (*runner_up).min(c)
@@ -254,13 +262,13 @@ fuzzyvox_core::dispatched! {
         }
         (0..n)
             .map(|i| PixelState {
-                best: best[i],
+                best: best[i] as u16,
                 best_plane: best_plane[i],
                 run_end: run_end[i],
                 exclusion: exclusion[i],
-                left: left[i],
-                right: right[i],
-                runner_up: runner_up[i],
+                left: left[i] as u16,
+                right: right[i] as u16,
+                runner_up: runner_up[i] as u16,
                 low: low[i],
                 high: high[i],
             })

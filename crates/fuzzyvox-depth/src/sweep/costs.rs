@@ -129,10 +129,14 @@ pub(super) fn tagged_codes(census: &CensusImage) -> TaggedImage {
 /// division's rounding error, and truncating the float quotient gives the integer one.
 #[inline(always)]
 fn mean_cost(sum: u16, count: u16) -> u8 {
-    let numerator = u32::from(sum) * COST_SCALE + u32::from(count) / 2;
-    let quotient = numerator as f32 / f32::from(count);
+    let numerator = (u32::from(sum) * COST_SCALE + u32::from(count) / 2) as i32;
+    // Divided by at least 1 and floored by `floor_small` (the mean is below 2^8, and every
+    // step is one vector instruction: a saturating `as` would not vectorise); the truncation
+    // to `u8` keeps the whole value.
+    let quotient = numerator as f32 / f32::from(count.max(1));
+    let mean = floor_small(quotient) as u8;
     if count > 0 {
-        quotient as u8
+        mean
     } else {
         (u32::from(CENSUS_MAX_COST) * COST_SCALE) as u8
     }
