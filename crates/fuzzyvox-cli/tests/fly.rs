@@ -154,11 +154,18 @@ fn looking_aside_at_take_off_sees_the_wall_that_forward_motion_misses() {
         integrate_prior(&scenario, &mut map, &goal.from, &config).unwrap();
         fly_goal(&scenario, &goal.from, &goal.to, &mut map, &config, 5).unwrap()
     };
-    // Flying straight at it, the vehicle sees the face only from along its view and hits it.
+    // Flying straight at it, the vehicle sees the face only from along its view: it flies
+    // to within a metre and a half of it before it learns of it, and then either hits it or
+    // dodges about it without reaching the goal.
     let straight = fly(0.0);
-    assert_eq!(
+    assert_ne!(
         straight.ending,
-        Ending::Collided,
+        Ending::Reached,
+        "{:?}",
+        straight.trajectory
+    );
+    assert!(
+        straight.trajectory.iter().any(|p| p.x > 2.9),
         "{:?}",
         straight.trajectory
     );
@@ -170,7 +177,7 @@ fn looking_aside_at_take_off_sees_the_wall_that_forward_motion_misses() {
         first.x.abs() < 1e-9 && first.y.abs() > 0.4,
         "first step {first:?}"
     );
-    assert_ne!(looked.ending, Ending::Collided, "{:?}", looked.trajectory);
+    assert_eq!(looked.ending, Ending::Reached, "{:?}", looked.trajectory);
     assert!(
         looked.trajectory.iter().any(|p| p.x > 5.0),
         "{:?}",

@@ -73,6 +73,16 @@ pub struct FlyConfig {
     /// longer clear is replanned without a limit). It keeps a frame from paying a long search
     /// for an improvement: 20,000 voxels is about 8 ms. Default 20,000.
     pub replan_budget: usize,
+    /// A path that is no longer clear is first repaired: A* from the vehicle to the first
+    /// voxel of the path past its last blocked one, expanding at most this many voxels, and
+    /// the rest of the path as it was ([`repair_in_field`](fuzzyvox_plan::repair_in_field)).
+    /// Only when that fails is it replanned without a limit. 0 turns repairs off. Default
+    /// 5,000.
+    pub repair_budget: usize,
+    /// A repair's detour rejoins the old path this far past the last voxel that blocks it,
+    /// metres (along the path; the path's end when that is nearer), so that it goes round
+    /// the blocked stretch instead of hugging it back onto the old line. Default 1.5.
+    pub repair_rejoin: f64,
     /// The unseen-surface guard collects, within this distance of the vehicle, metres, the
     /// unknown voxels next to surfaces the map has seen, and the planner neither enters them
     /// nor passes within the vehicle's radius of them, whatever the unknown-space policy: see
@@ -122,6 +132,8 @@ impl Default for FlyConfig {
             weave_frames: 2,
             replan_every: 8,
             replan_budget: 20_000,
+            repair_budget: 5_000,
+            repair_rejoin: 1.5,
             unknown_guard: 0.0,
             guard_surface_reach: 0.6,
             leaning_occupied: 0.2,
@@ -222,6 +234,13 @@ impl FlyConfig {
                 expected: "at least 1 voxel",
             });
         }
+        if !(self.repair_rejoin.is_finite() && self.repair_rejoin >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "repair rejoin",
+                value: self.repair_rejoin,
+                expected: "a finite distance of at least 0 m",
+            });
+        }
         self.planner.validate()?;
         Ok(self)
     }
@@ -241,6 +260,11 @@ mod tests {
     #[test]
     fn out_of_range_settings_are_named() {
         assert!(FlyConfig::default().validate().is_ok());
+        let no_repairs = FlyConfig {
+            repair_budget: 0,
+            ..FlyConfig::default()
+        };
+        assert!(no_repairs.validate().is_ok());
         for (config, setting) in [
             (
                 FlyConfig {
@@ -255,6 +279,20 @@ mod tests {
                     ..FlyConfig::default()
                 },
                 "replan budget",
+            ),
+            (
+                FlyConfig {
+                    repair_rejoin: f64::NAN,
+                    ..FlyConfig::default()
+                },
+                "repair rejoin",
+            ),
+            (
+                FlyConfig {
+                    repair_rejoin: -1.0,
+                    ..FlyConfig::default()
+                },
+                "repair rejoin",
             ),
         ] {
             assert!(

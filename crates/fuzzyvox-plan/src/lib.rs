@@ -35,6 +35,7 @@ mod plan_path;
 mod planner;
 mod queries;
 mod region;
+mod repair;
 mod rules;
 mod smooth;
 
@@ -50,4 +51,5 @@ pub use plan_path::plan_path;
 pub use planner::Planner;
 pub use queries::SafetyQueries;
 pub use region::PlanningRegion;
+pub use repair::repair_in_field;
 pub use rules::is_blocked;

@@ -12,7 +12,7 @@ use crate::error::PlanError;
 use crate::field_update::FieldUpdate;
 use crate::path::{Path, plan_in_field};
 use crate::region::PlanningRegion;
-use crate::smooth::segment_voxels;
+use crate::smooth::{interior_voxels, segment_voxels};
 
 /// The cost field of one region of one map, kept current as the map changes.
 ///
@@ -110,8 +110,9 @@ impl Planner {
     }
 
     /// Whether every straight leg of `waypoints` crosses only traversable voxels of the
-    /// current field (the test the planner's own shortcuts pass), so that a path planned
-    /// earlier can be kept while the map grows.
+    /// current field (the test the planner's own shortcuts pass), for a step the caller is
+    /// about to take. For a path the planner gave, kept while the map grows, see
+    /// [`is_path_clear_avoiding`](Planner::is_path_clear_avoiding).
     pub fn is_clear(&self, waypoints: &[Point3<f64>]) -> bool {
         self.is_clear_avoiding(waypoints, &|_| false)
     }
@@ -122,6 +123,36 @@ impl Planner {
         &self,
         waypoints: &[Point3<f64>],
         avoid: &dyn Fn(usize) -> bool,
+    ) -> bool {
+        self.legs_clear(waypoints, avoid, |f, a, b, visit| {
+            segment_voxels(f, a, b, visit)
+        })
+    }
+
+    /// Whether a path the planner gave (waypoints at voxel centres, the first where the
+    /// vehicle is) is still clear in the current field: every leg crosses only traversable
+    /// voxels that `avoid` allows, the first waypoint's voxel excepted. A leg crosses the
+    /// voxels it passes through over a stretch of positive length; where it meets a voxel edge
+    /// or corner exactly, the voxels that only touch it there do not count, as in A*'s own
+    /// steps between diagonal neighbours. So every path the planner gives is clear in the
+    /// field it was planned in, which [`is_clear_avoiding`](Planner::is_clear_avoiding)'s ray
+    /// walk does not promise where a path passes a corner diagonally.
+    pub fn is_path_clear_avoiding(
+        &self,
+        waypoints: &[Point3<f64>],
+        avoid: &dyn Fn(usize) -> bool,
+    ) -> bool {
+        self.legs_clear(waypoints, avoid, |f, a, b, visit| {
+            interior_voxels(f, a, b, visit)
+        })
+    }
+
+    /// Whether `walk` passes every leg of `waypoints` through enterable voxels.
+    fn legs_clear(
+        &self,
+        waypoints: &[Point3<f64>],
+        avoid: &dyn Fn(usize) -> bool,
+        walk: fn(&CostField, VoxelKey, VoxelKey, &mut dyn FnMut(usize) -> bool) -> bool,
     ) -> bool {
         let resolution = self.field.resolution();
         let keys: Option<Vec<VoxelKey>> = waypoints
@@ -135,12 +166,12 @@ impl Planner {
         let Some(first) = keys.first().and_then(|k| region.index_of(*k)) else {
             return false;
         };
-        let enter = |i: usize| self.field.is_traversable(i) && (i == first || !avoid(i));
+        let mut enter = |i: usize| self.field.is_traversable(i) && (i == first || !avoid(i));
         match keys.as_slice() {
             [_] => enter(first),
             _ => keys
                 .windows(2)
-                .all(|leg| segment_voxels(&self.field, leg[0], leg[1], enter)),
+                .all(|leg| walk(&self.field, leg[0], leg[1], &mut enter)),
         }
     }
 }

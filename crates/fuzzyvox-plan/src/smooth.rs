@@ -33,6 +33,59 @@ pub(crate) fn segment_voxels(
     ok && region.index_of(to).is_some_and(visit)
 }
 
+/// Calls `visit` with the dense index of every voxel the straight segment between two voxel
+/// centres passes through over a stretch of positive length, in order from `from` to `to`
+/// (both included), stopping early when `visit` returns false; returns false when stopped or
+/// when the segment leaves the region.
+///
+/// Where the segment crosses a voxel edge or corner exactly, the voxels that only touch it
+/// there are not visited ([`segment_voxels`] visits one of them, as a ray walk breaks the
+/// tie). So this is the exact test of the paths the planner gives: an A* step between
+/// diagonal neighbours crosses only its two voxels, a leg [`segment_voxels`] passed crosses a
+/// subset of what it visited, and a leg merged from collinear legs crosses what they crossed.
+/// Exact: the crossings are compared as fractions of integers.
+pub(crate) fn interior_voxels(
+    field: &CostField,
+    from: VoxelKey,
+    to: VoxelKey,
+    mut visit: impl FnMut(usize) -> bool,
+) -> bool {
+    let region = field.region();
+    let d = [to.x - from.x, to.y - from.y, to.z - from.z].map(i64::from);
+    let n = d.map(i64::abs);
+    let mut key = [from.x, from.y, from.z];
+    // Voxel faces crossed so far along each axis. The segment crosses the `k`-th face of axis
+    // `a` at the fraction `(2k + 1) / (2 n[a])` of its length.
+    let mut crossed = [0i64; 3];
+    // Whether axis `a`'s next crossing comes before (`Less`) or with axis `b`'s.
+    let order = |crossed: &[i64; 3], a: usize, b: usize| {
+        ((2 * crossed[a] + 1) * n[b]).cmp(&((2 * crossed[b] + 1) * n[a]))
+    };
+    loop {
+        let Some(index) = region.index_of(VoxelKey::new(key[0], key[1], key[2])) else {
+            return false;
+        };
+        if !visit(index) {
+            return false;
+        }
+        let mut first: Option<usize> = None;
+        for a in (0..3).filter(|&a| crossed[a] < n[a]) {
+            if first.is_none_or(|f| order(&crossed, a, f).is_lt()) {
+                first = Some(a);
+            }
+        }
+        let Some(first) = first else {
+            return true;
+        };
+        let together: [bool; 3] =
+            std::array::from_fn(|a| crossed[a] < n[a] && order(&crossed, a, first).is_eq());
+        for a in (0..3).filter(|&a| together[a]) {
+            crossed[a] += 1;
+            key[a] += d[a].signum() as i32;
+        }
+    }
+}
+
 /// Greedy line-of-sight shortcutting: from each kept waypoint, jump to the farthest later
 /// voxel of the path whose straight segment crosses only traversable voxels.
 pub(crate) fn shortcut(
@@ -234,5 +287,125 @@ mod tests {
                 assert!(k.iter().all(|key| region.index_of(*key).is_some()));
             }
         }
+    }
+
+    fn visited(
+        field: &CostField,
+        from: VoxelKey,
+        to: VoxelKey,
+        walk: fn(&CostField, VoxelKey, VoxelKey, &mut dyn FnMut(usize) -> bool) -> bool,
+    ) -> Vec<usize> {
+        let mut seen = Vec::new();
+        assert!(walk(field, from, to, &mut |i| {
+            seen.push(i);
+            true
+        }));
+        seen
+    }
+
+    fn interior(f: &CostField, a: VoxelKey, b: VoxelKey, v: &mut dyn FnMut(usize) -> bool) -> bool {
+        interior_voxels(f, a, b, v)
+    }
+
+    fn walked(f: &CostField, a: VoxelKey, b: VoxelKey, v: &mut dyn FnMut(usize) -> bool) -> bool {
+        segment_voxels(f, a, b, v)
+    }
+
+    /// A step to any of the 26 neighbours crosses its two voxels alone; a longer segment
+    /// crosses, in order, a chain of 26-neighbours from one end to the other, every one of
+    /// them a voxel the ray walk visits too, and all of them along an axis.
+    #[test]
+    fn interior_voxels_skip_touched_edges_and_corners_only() {
+        let field = open_field(false);
+        let region = *field.region();
+        let at = |x, y, z| region.index_of(VoxelKey::new(x, y, z)).unwrap();
+        let centre = VoxelKey::new(20, 20, 10);
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let to = VoxelKey::new(20 + dx, 20 + dy, 10 + dz);
+                    let expected = if to == centre {
+                        vec![at(20, 20, 10)]
+                    } else {
+                        vec![at(20, 20, 10), at(20 + dx, 20 + dy, 10 + dz)]
+                    };
+                    assert_eq!(visited(&field, centre, to, interior), expected);
+                }
+            }
+        }
+        let along = visited(
+            &field,
+            VoxelKey::new(3, 7, 2),
+            VoxelKey::new(30, 7, 2),
+            interior,
+        );
+        assert_eq!(
+            along,
+            visited(
+                &field,
+                VoxelKey::new(3, 7, 2),
+                VoxelKey::new(30, 7, 2),
+                walked
+            )
+        );
+        for (from, to) in [
+            ([2, 3, 4], [37, 29, 11]),
+            ([30, 2, 18], [1, 39, 0]),
+            ([5, 5, 5], [25, 15, 5]),
+            ([10, 10, 10], [16, 13, 19]),
+            ([0, 40, 20], [40, 0, 0]),
+        ] {
+            let (from, to) = (
+                VoxelKey::new(from[0], from[1], from[2]),
+                VoxelKey::new(to[0], to[1], to[2]),
+            );
+            let inner = visited(&field, from, to, interior);
+            let ray = visited(&field, from, to, walked);
+            assert_eq!(inner.first(), Some(&region.index_of(from).unwrap()));
+            assert_eq!(inner.last(), Some(&region.index_of(to).unwrap()));
+            assert!(inner.iter().all(|i| ray.contains(i)), "{from:?} to {to:?}");
+            for pair in inner.windows(2) {
+                let (a, b) = (region.key_at(pair[0]), region.key_at(pair[1]));
+                let d = [b.x - a.x, b.y - a.y, b.z - a.z];
+                assert!(d.iter().all(|c| c.abs() <= 1) && d != [0, 0, 0]);
+            }
+        }
+    }
+
+    /// Every leg of a planned path crosses only traversable voxels by the interior test (the
+    /// test a closed loop keeps its path by), also where A* steps diagonally past a corner of
+    /// the blocked space round the pillar.
+    #[test]
+    fn planned_paths_cross_only_traversable_voxels() {
+        let field = open_field(true);
+        let resolution = field.resolution();
+        let mut diagonal_corners = 0;
+        for (start, goal) in [
+            ([5, 20, 10], [35, 20, 10]),
+            ([5, 5, 5], [35, 35, 15]),
+            ([20, 5, 10], [20, 35, 10]),
+            ([8, 19, 4], [33, 21, 16]),
+            ([10, 12, 3], [30, 28, 3]),
+            ([30, 12, 17], [10, 27, 2]),
+        ] {
+            let (start, goal) = (
+                VoxelKey::new(start[0], start[1], start[2]),
+                VoxelKey::new(goal[0], goal[1], goal[2]),
+            );
+            let path = plan_in_field(&field, start, goal).unwrap();
+            let keys: Vec<VoxelKey> = path
+                .waypoints
+                .iter()
+                .map(|p| resolution.key_of(p).unwrap())
+                .collect();
+            for leg in keys.windows(2) {
+                assert!(interior_voxels(&field, leg[0], leg[1], traversable(&field)));
+                if !segment_voxels(&field, leg[0], leg[1], traversable(&field)) {
+                    diagonal_corners += 1;
+                }
+            }
+        }
+        // The ray walk refuses some of these legs: the interior test is what keeps them.
+        assert!(diagonal_corners > 0);
     }
 }

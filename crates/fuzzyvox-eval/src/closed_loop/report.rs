@@ -94,6 +94,8 @@ pub struct FlightRecord {
     pub depth_refused: usize,
     /// Times the path was planned again.
     pub replans: usize,
+    /// Times a blocked path was repaired instead of planned again.
+    pub repairs: usize,
     /// The vehicle's positions, the start first.
     pub trajectory: Vec<[f64; 3]>,
 }
@@ -108,6 +110,7 @@ impl From<&FlightLog> for FlightRecord {
             depth_images: f.depth_images,
             depth_refused: f.depth_refused,
             replans: f.replans,
+            repairs: f.repairs,
             trajectory: f.trajectory.iter().map(|p| [p.x, p.y, p.z]).collect(),
         }
     }

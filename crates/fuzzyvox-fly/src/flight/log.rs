@@ -54,6 +54,8 @@ pub struct FlightLog {
     pub depth_refused: usize,
     /// Times the cost field was built and a path planned.
     pub replans: usize,
+    /// Times a blocked path was repaired round what blocks it instead of planned again.
+    pub repairs: usize,
     /// Per-cycle times.
     pub cycles: Vec<CycleTimes>,
 }

@@ -207,6 +207,7 @@ impl<'a> Flight<'a> {
                 depth_images: 0,
                 depth_refused: 0,
                 replans: 0,
+                repairs: 0,
                 cycles: Vec::new(),
             },
         })

@@ -3,7 +3,7 @@
 //! voxels when the vehicle only looks for a better path.
 
 use fuzzyvox_core::storage::VoxelKey;
-use fuzzyvox_plan::{CostField, PlanError, plan_in_field_within};
+use fuzzyvox_plan::{CostField, PlanError, plan_in_field_within, repair_in_field};
 use nalgebra::Point3;
 
 /// What a replan depends on besides the flight's goal: the cost field (through the planner's
@@ -67,9 +67,7 @@ pub(super) fn replan(
     }
 }
 
-/// Plans through `field` from `position` to the goal. When the voxel the vehicle is in cannot
-/// be entered (the map learnt that something is near), plans from the nearest traversable
-/// voxel within half a metre instead. Never enters a voxel `avoid` names (the start
+/// Plans through `field` from `position` to the goal, from the voxel [`start_voxel`] gives. Never enters a voxel `avoid` names (the start
 /// excepted). Each search expands at most `limit` voxels; `Ok(None)` when one ran out.
 fn plan_from(
     field: &CostField,
@@ -79,31 +77,7 @@ fn plan_from(
     limit: usize,
 ) -> std::result::Result<Option<Vec<Point3<f64>>>, PlanError> {
     let resolution = field.resolution();
-    let region = *field.region();
-    let here = resolution.key_of(&position)?;
-    let start = match region.index_of(here) {
-        Some(index) if !field.is_traversable(index) => {
-            let reach = (0.5 / resolution.size()).ceil() as i32;
-            let mut best: Option<(i32, VoxelKey)> = None;
-            for dz in -reach..=reach {
-                for dy in -reach..=reach {
-                    for dx in -reach..=reach {
-                        let key = VoxelKey::new(here.x + dx, here.y + dy, here.z + dz);
-                        let d2 = dx * dx + dy * dy + dz * dz;
-                        if best.is_none_or(|(b, _)| d2 < b)
-                            && region
-                                .index_of(key)
-                                .is_some_and(|i| field.is_traversable(i) && !avoid(i))
-                        {
-                            best = Some((d2, key));
-                        }
-                    }
-                }
-            }
-            best.map_or(here, |(_, key)| key)
-        }
-        _ => here,
-    };
+    let start = start_voxel(field, position, avoid)?;
     let found = match plan_in_field_within(field, start, goal, avoid, limit) {
         // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
         // it (the known-safe frontier towards the goal), see more, and plan again there.
@@ -125,6 +99,63 @@ fn plan_from(
         *first = position;
     }
     Ok(Some(path.waypoints))
+}
+
+/// The voxel to plan from at `position`: the one the vehicle is in, or, when that one cannot
+/// be entered (the map learnt that something is near), the nearest traversable voxel within
+/// half a metre that `avoid` allows (the vehicle's own when there is none).
+fn start_voxel(
+    field: &CostField,
+    position: Point3<f64>,
+    avoid: &dyn Fn(usize) -> bool,
+) -> std::result::Result<VoxelKey, PlanError> {
+    let resolution = field.resolution();
+    let region = *field.region();
+    let here = resolution.key_of(&position)?;
+    Ok(match region.index_of(here) {
+        Some(index) if !field.is_traversable(index) => {
+            let reach = (0.5 / resolution.size()).ceil() as i32;
+            let mut best: Option<(i32, VoxelKey)> = None;
+            for dz in -reach..=reach {
+                for dy in -reach..=reach {
+                    for dx in -reach..=reach {
+                        let key = VoxelKey::new(here.x + dx, here.y + dy, here.z + dz);
+                        let d2 = dx * dx + dy * dy + dz * dz;
+                        if best.is_none_or(|(b, _)| d2 < b)
+                            && region
+                                .index_of(key)
+                                .is_some_and(|i| field.is_traversable(i) && !avoid(i))
+                        {
+                            best = Some((d2, key));
+                        }
+                    }
+                }
+            }
+            best.map_or(here, |(_, key)| key)
+        }
+        _ => here,
+    })
+}
+
+/// Repairs `path` (blocked in `field`; its first point is where the vehicle is) round what
+/// blocks it, from the voxel [`plan_from`] would start at, rejoining it `rejoin` metres past
+/// what blocks it and expanding at most `limit` voxels ([`repair_in_field`]); `None` when it
+/// cannot.
+pub(super) fn repair(
+    field: &CostField,
+    position: Point3<f64>,
+    path: &[Point3<f64>],
+    avoid: &dyn Fn(usize) -> bool,
+    rejoin: f64,
+    limit: usize,
+) -> Option<Vec<Point3<f64>>> {
+    let start = start_voxel(field, position, avoid).ok()?;
+    let rejoin_after = (rejoin / field.resolution().size()).ceil() as usize;
+    let mut repaired = repair_in_field(field, start, path, avoid, rejoin_after, limit)?;
+    if let Some(first) = repaired.first_mut() {
+        *first = position;
+    }
+    Some(repaired)
 }
 
 /// The traversable voxel connected to `start` (through the field's 26-neighbourhood) nearest

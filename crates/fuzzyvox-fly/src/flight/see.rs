@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 
 use super::geometry::{level, point_ahead, turn_towards};
 use super::log::CycleTimes;
-use super::replan::{ReplanInputs, Replanned, replan};
+use super::replan::{ReplanInputs, Replanned, repair, replan};
 use super::{Flight, Sight};
 
 impl Flight<'_> {
@@ -121,8 +121,26 @@ impl Flight<'_> {
         let clear = self
             .path
             .as_deref()
-            .is_some_and(|p| p.len() >= 2 && self.planner.is_clear_avoiding(p, &avoid));
-        if clear && self.since_plan < self.config.replan_every {
+            .is_some_and(|p| p.len() >= 2 && self.planner.is_path_clear_avoiding(p, &avoid));
+        let repaired = if clear || self.config.repair_budget == 0 {
+            None
+        } else {
+            // A blocked path is first repaired round what blocks it, within a budget.
+            self.path.as_deref().and_then(|old| {
+                repair(
+                    self.planner.field(),
+                    self.position,
+                    old,
+                    &avoid,
+                    self.config.repair_rejoin,
+                    self.config.repair_budget,
+                )
+            })
+        };
+        if let Some(path) = repaired {
+            self.path = Some(path);
+            self.log.repairs += 1;
+        } else if clear && self.since_plan < self.config.replan_every {
             self.since_plan += 1;
         } else {
             // A clear path is only looked at again for a better one, within the budget; a
