@@ -7,7 +7,8 @@
 //!   cost field's update, keeping or replanning the path);
 //! - `steer`: the step along the path (weaving, looking aside, the view rule) and its check
 //!   against the true scene;
-//! - `replan`: A* from the vehicle's position, or towards the reachable voxel nearest the goal;
+//! - `replan`: A* from the vehicle's position, or towards the reachable voxel nearest the goal,
+//!   and the repair of a blocked path;
 //! - `geometry`: polylines and headings;
 //! - `prior`: what the vehicle knows before take-off;
 //! - `log`: what a flight did.

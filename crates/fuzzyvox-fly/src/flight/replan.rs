@@ -1,6 +1,10 @@
 //! Planning from where the vehicle is: A* through the cost field, or towards the reachable
 //! voxel nearest the goal when the goal cannot be reached yet; within a budget of expanded
-//! voxels when the vehicle only looks for a better path.
+//! voxels when the vehicle only looks for a better path; and the repair of a blocked path
+//! round what blocks it.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 use fuzzyvox_core::storage::VoxelKey;
 use fuzzyvox_plan::{CostField, PlanError, plan_in_field_within, repair_in_field};
@@ -82,7 +86,7 @@ fn plan_from(
         // The goal cannot be entered or reached yet: fly to the reachable voxel nearest to
         // it (the known-safe frontier towards the goal), see more, and plan again there.
         Err(PlanError::GoalUnsafe(_) | PlanError::GoalAvoided | PlanError::Disconnected { .. }) => {
-            let target = nearest_reachable(field, start, goal, avoid)
+            let target = nearest_reachable(field, start, goal, avoid, NEAREST_SEARCH)
                 .ok_or(PlanError::Disconnected { expanded: 0 })?;
             if resolution.center(target) == resolution.center(start) {
                 return Err(PlanError::Disconnected { expanded: 0 });
@@ -158,33 +162,44 @@ pub(super) fn repair(
     Some(repaired)
 }
 
-/// The traversable voxel connected to `start` (through the field's 26-neighbourhood) nearest
-/// to `goal` without entering a voxel `avoid` names, ties to the lowest index; `None` when
-/// `start` is not traversable.
+/// The most voxels [`nearest_reachable`] takes from its queue: the search for where to fly
+/// when the goal cannot be reached yet costs a bounded time, as a periodic replan does, however
+/// large the region the vehicle can reach.
+const NEAREST_SEARCH: usize = 5_000;
+
+/// The traversable voxel connected to `start` (through the field's 26-neighbourhood, never
+/// entering a voxel `avoid` names) nearest to `goal`, ties to the lowest index, among the
+/// first `limit` voxels a best-first search takes: nearest to the goal first, so the search
+/// heads for the goal and spreads along what stops it there. Exact when the voxels connected
+/// to `start` are at most `limit`. `None` when `start` is not traversable.
 fn nearest_reachable(
     field: &CostField,
     start: VoxelKey,
     goal: VoxelKey,
     avoid: &dyn Fn(usize) -> bool,
+    limit: usize,
 ) -> Option<VoxelKey> {
     let region = field.region();
     let first = region
         .index_of(start)
         .filter(|&i| field.is_traversable(i))?;
-    let mut seen = vec![false; region.len()];
-    let mut queue = std::collections::VecDeque::from([first]);
-    seen[first] = true;
     let distance = |key: VoxelKey| {
         let d = [key.x - goal.x, key.y - goal.y, key.z - goal.z].map(i64::from);
         d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
     };
+    // Zeroed pages from the system: only those the search touches are written.
+    let mut seen = vec![false; region.len()];
+    seen[first] = true;
+    let mut queue = BinaryHeap::from([Reverse((distance(start), first))]);
     let mut best = (distance(start), first);
-    while let Some(index) = queue.pop_front() {
-        let key = region.key_at(index);
-        let d = distance(key);
-        if d < best.0 || (d == best.0 && index < best.1) {
-            best = (d, index);
+    let mut taken = 0;
+    while let Some(Reverse((d, index))) = queue.pop() {
+        if taken == limit {
+            break;
         }
+        taken += 1;
+        best = best.min((d, index));
+        let key = region.key_at(index);
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
@@ -195,7 +210,7 @@ fn nearest_reachable(
                         && !avoid(n)
                     {
                         seen[n] = true;
-                        queue.push_back(n);
+                        queue.push(Reverse((distance(next), n)));
                     }
                 }
             }
@@ -206,7 +221,62 @@ fn nearest_reachable(
 
 #[cfg(test)]
 mod tests {
+    use fuzzyvox_core::map::FunctionMap;
+    use fuzzyvox_core::measures::Memberships;
+    use fuzzyvox_core::storage::Resolution;
+    use fuzzyvox_plan::{PlannerConfig, PlanningRegion};
+
     use super::*;
+
+    /// A 6 × 2 × 1 m box of seen free space at 0.1 m, cut across by an occupied wall at x 4 m:
+    /// a goal behind the wall cannot be reached.
+    fn walled() -> CostField {
+        let map = FunctionMap::new(Resolution::new(0.1).unwrap(), |key| {
+            if key.x == 40 {
+                Memberships {
+                    occupied: 0.95,
+                    free: 0.0,
+                }
+            } else {
+                Memberships {
+                    occupied: 0.0,
+                    free: 0.95,
+                }
+            }
+        });
+        let region = PlanningRegion::new(VoxelKey::new(0, 0, 0), VoxelKey::new(59, 19, 9)).unwrap();
+        let config = PlannerConfig {
+            vehicle_radius: 0.1,
+            ..PlannerConfig::default()
+        };
+        CostField::build(&map, region, config).unwrap()
+    }
+
+    /// Searching every reachable voxel gives the one nearest the goal in front of the wall; a
+    /// search of a few hundred voxels heads for the goal and finds the same one, and one of a
+    /// single voxel gives the start.
+    #[test]
+    fn the_nearest_reachable_voxel_is_found_heading_for_the_goal() {
+        let field = walled();
+        let (start, goal) = (VoxelKey::new(3, 10, 5), VoxelKey::new(50, 12, 5));
+        let none = |_: usize| false;
+        let exact = nearest_reachable(&field, start, goal, &none, usize::MAX).unwrap();
+        assert!(field.is_traversable(field.region().index_of(exact).unwrap()));
+        assert_eq!((exact.y, exact.z), (12, 5));
+        assert!((36..40).contains(&exact.x), "{exact:?}");
+        assert_eq!(
+            nearest_reachable(&field, start, goal, &none, 600),
+            Some(exact)
+        );
+        assert_eq!(
+            nearest_reachable(&field, start, goal, &none, 1),
+            Some(start)
+        );
+        // What `avoid` names is never entered.
+        let fence = |index: usize| field.region().key_at(index).x >= 20;
+        let fenced = nearest_reachable(&field, start, goal, &fence, usize::MAX).unwrap();
+        assert_eq!(fenced.x, 19);
+    }
 
     /// The last outcome comes back while the inputs are equal; any changed input plans again.
     #[test]
