@@ -71,8 +71,8 @@ pub(super) fn replan(
     }
 }
 
-/// Plans through `field` from `position` to the goal, from the voxel [`start_voxel`] gives. Never enters a voxel `avoid` names (the start
-/// excepted). Each search expands at most `limit` voxels; `Ok(None)` when one ran out.
+/// Plans through `field` from `position` to the goal, from the voxel [`start_voxel`] gives.
+/// Never enters a voxel `avoid` names (the start excepted). Each search expands at most `limit` voxels; `Ok(None)` when one ran out.
 fn plan_from(
     field: &CostField,
     position: Point3<f64>,
@@ -142,9 +142,10 @@ fn start_voxel(
 }
 
 /// Repairs `path` (blocked in `field`; its first point is where the vehicle is) round what
-/// blocks it, from the voxel [`plan_from`] would start at, rejoining it `rejoin` metres past
-/// what blocks it and expanding at most `limit` voxels ([`repair_in_field`]); `None` when it
-/// cannot.
+/// blocks it, from the voxel [`plan_from`] would start at, rejoining it `rejoin` metres (in
+/// voxels crossed, so at least that far along the path) past what blocks it and expanding at
+/// most `limit` voxels ([`repair_in_field`]); `None` when it cannot, or when the repair would
+/// leave fewer than two waypoints (the loop then plans in full).
 pub(super) fn repair(
     field: &CostField,
     position: Point3<f64>,
@@ -159,7 +160,7 @@ pub(super) fn repair(
     if let Some(first) = repaired.first_mut() {
         *first = position;
     }
-    Some(repaired)
+    Some(repaired).filter(|p| p.len() >= 2)
 }
 
 /// The most voxels [`nearest_reachable`] takes from its queue: the search for where to fly
