@@ -30,7 +30,7 @@ pub use evidence::{
 pub use frustum::depth_evidence;
 pub use octomap_walk::walk_ray_octomap;
 pub use points::cloud_evidence;
-pub(crate) use points::{check_cloud, cloud_evidence_checked};
+pub(crate) use points::{CloudScan, check_cloud, cloud_scan_checked};
 pub use raywalk::{walk_ray, walk_ray_until};
 pub use scan_sets::{
     BlockFlags, BlockLevels, CellMarks, ScanBlocks, ScanLevels, ScanSets, scan_levels, scan_sets,

@@ -220,7 +220,7 @@ impl<B: CellMarks> ScanBlocks<B> {
     }
 
     /// No voxel marked, for rays inside the box of voxel keys `lo..=hi`.
-    fn for_box(lo: VoxelKey, hi: VoxelKey) -> Self {
+    pub(crate) fn for_box(lo: VoxelKey, hi: VoxelKey) -> Self {
         Self {
             index: BlockIndex::for_box(lo.block(), hi.block()),
             keys: Vec::new(),
@@ -233,8 +233,9 @@ impl<B: CellMarks> ScanBlocks<B> {
         self.keys.iter().copied().zip(self.blocks.iter())
     }
 
+    /// The position of block `key` in the record, added unmarked if new.
     #[inline]
-    fn position(&mut self, key: BlockKey) -> usize {
+    pub(crate) fn position(&mut self, key: BlockKey) -> usize {
         if let Some(position) = self.index.get(key) {
             return position;
         }
@@ -245,8 +246,14 @@ impl<B: CellMarks> ScanBlocks<B> {
         position
     }
 
+    /// The marks of the block at `position` (from [`ScanBlocks::position`]).
+    #[inline]
+    pub(crate) fn block_at_mut(&mut self, position: usize) -> Option<&mut B> {
+        self.blocks.get_mut(position)
+    }
+
     /// Unites two partial scans (exact, so the split does not matter).
-    fn union(mut self, other: Self) -> Self {
+    pub(crate) fn union(mut self, other: Self) -> Self {
         if self.blocks.len() < other.blocks.len() {
             return other.union(self);
         }
@@ -336,7 +343,11 @@ const CHUNK: usize = 1024;
 /// The box of voxel keys that every ray of the scan stays in: the keys of the origin and of
 /// the finite end points (in single precision, as the walk sees them), one voxel wider on
 /// each side.
-fn key_box(cloud: &PointCloud, resolution: &Resolution, origin: &[f32; 3]) -> (VoxelKey, VoxelKey) {
+pub(crate) fn key_box(
+    cloud: &PointCloud,
+    resolution: &Resolution,
+    origin: &[f32; 3],
+) -> (VoxelKey, VoxelKey) {
     let key_of = |p: [f32; 3]| {
         resolution.try_key_of(&Point3::new(
             f64::from(p[0]),

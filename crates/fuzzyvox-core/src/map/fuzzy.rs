@@ -7,14 +7,21 @@ use super::logodds::check_scans;
 use super::{VoxelMap, VoxelMapMut};
 use crate::error::{Error, Result};
 use crate::integrate::{
-    Checked, DepthFrame, Evidence, IntegrationOptions, IntegrationStats, PointCloud, ScanEvidence,
-    check_cloud, cloud_evidence, cloud_evidence_checked, depth_evidence, scan_groups,
+    BlockFlags, Checked, CloudScan, DepthFrame, Evidence, IntegrationOptions, IntegrationStats,
+    PointCloud, ScanEvidence, check_cloud, cloud_scan_checked, depth_evidence, scan_groups,
 };
 use crate::measures::{MeasureConfig, Memberships, VoxelClass};
 use crate::ops::TConorm;
 use crate::storage::{
     BLOCK_CELLS, Block, BlockGrid, BlockKey, KeyBox, PackedGrid, Resolution, VoxelKey,
 };
+
+/// One block of a [`CloudScan::Uniform`]: its occupied evidence and its cleared voxels, each
+/// when the scan reached the block.
+struct UniformSource<'a> {
+    occupied: Option<&'a Block<Evidence>>,
+    passed: Option<&'a BlockFlags>,
+}
 
 /// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
 /// and how free (μE), each aggregated from evidence with a t-conorm `S`:
@@ -90,6 +97,71 @@ impl FuzzyMap {
         })
     }
 
+    /// Folds one scan of a cloud into the map, as [`FuzzyMap::apply_evidence`] folds the
+    /// same scan's evidence.
+    fn apply_scan(&mut self, scan: &CloudScan) -> usize {
+        let (occupied, passed, free) = match scan {
+            CloudScan::Evidence(evidence) => return self.apply_evidence(evidence),
+            CloudScan::Uniform {
+                occupied,
+                passed,
+                free,
+            } => (occupied, passed, *free),
+        };
+        // One source per block that either part reached, so that the blocks are allocated
+        // and written exactly as by the scan's evidence.
+        let mut sources: Vec<(BlockKey, UniformSource<'_>)> = occupied
+            .blocks()
+            .map(|(key, block)| {
+                let source = UniformSource {
+                    occupied: Some(block),
+                    passed: None,
+                };
+                (key, source)
+            })
+            .collect();
+        let mut index: rustc_hash::FxHashMap<BlockKey, usize> = sources
+            .iter()
+            .enumerate()
+            .map(|(i, (key, _))| (*key, i))
+            .collect();
+        for (key, flags) in passed.blocks() {
+            match index.get(&key) {
+                Some(&i) => sources[i].1.passed = Some(flags),
+                None => {
+                    index.insert(key, sources.len());
+                    let source = UniformSource {
+                        occupied: None,
+                        passed: Some(flags),
+                    };
+                    sources.push((key, source));
+                }
+            }
+        }
+        let acc = self.accumulator;
+        let sources = sources.iter().map(|(key, s)| (*key, s)).collect();
+        self.update_cells(sources, |cell, s: &UniformSource<'_>, i, memo| {
+            let o = s.occupied.map_or(0.0, |b| b.cells[i].occupied);
+            let e = if s.passed.is_some_and(|f| f.get(i).0) {
+                free
+            } else {
+                0.0
+            };
+            // As `apply_evidence`: free and not occupied.
+            let e = e * (1.0 - o);
+            if o <= 0.0 && e <= 0.0 {
+                return false;
+            }
+            if o > 0.0 {
+                cell.occupied = acc.accumulate_level(cell.occupied, memo.level(&acc, o));
+            }
+            if e > 0.0 {
+                cell.free = acc.accumulate_level(cell.free, memo.level(&acc, e));
+            }
+            true
+        })
+    }
+
     /// Merges another map of the same resolution and operator into this one, cell by cell with
     /// `S`. The result equals inserting both maps' observations into one map, in any order.
     pub fn merge(&mut self, other: &FuzzyMap) -> Result<()> {
@@ -156,6 +228,18 @@ impl FuzzyMap {
         sources: Vec<(BlockKey, &Block<C>)>,
         update: impl Fn(&mut Levels, &C, &mut LevelMemo) -> bool + Sync,
     ) -> usize {
+        self.update_cells(sources, |cell, source: &Block<C>, i, memo| {
+            update(cell, &source.cells[i], memo)
+        })
+    }
+
+    /// [`FuzzyMap::update`] from any per-block source: `update` reads cell `i` of its
+    /// block's source itself.
+    fn update_cells<S: Sync>(
+        &mut self,
+        sources: Vec<(BlockKey, &S)>,
+        update: impl Fn(&mut Levels, &S, usize, &mut LevelMemo) -> bool + Sync,
+    ) -> usize {
         let acc = self.accumulator;
         let measures = self.config.measures;
         self.grid.update_blocks(sources, |block, source| {
@@ -165,9 +249,9 @@ impl FuzzyMap {
             // each distinct pair once in a row.
             let mut classes = ClassMemo::new(&acc, &measures);
             let mut levels = LevelMemo::default();
-            for (cell, s) in block.cells.iter_mut().zip(source.cells.iter()) {
+            for (i, cell) in block.cells.iter_mut().enumerate() {
                 let before = *cell;
-                if !update(cell, s, &mut levels) {
+                if !update(cell, source, i, &mut levels) {
                     continue;
                 }
                 updated += 1;
@@ -350,9 +434,15 @@ impl VoxelMapMut for FuzzyMap {
         options: &IntegrationOptions,
     ) -> Result<IntegrationStats> {
         let c = &self.config;
-        let (evidence, mut stats) =
-            cloud_evidence(cloud, &c.resolution, &c.evidence, &c.operator, options)?;
-        stats.voxels_updated = self.apply_evidence(&evidence);
+        let (scan, mut stats) = cloud_scan_checked(
+            cloud,
+            &c.resolution,
+            &c.evidence,
+            &c.operator,
+            options,
+            Checked::No,
+        )?;
+        stats.voxels_updated = self.apply_scan(&scan);
         Ok(stats)
     }
 
@@ -368,7 +458,7 @@ impl VoxelMapMut for FuzzyMap {
             let evidence = group
                 .par_iter()
                 .map(|cloud| {
-                    cloud_evidence_checked(
+                    cloud_scan_checked(
                         cloud,
                         &c.resolution,
                         &c.evidence,
@@ -378,8 +468,8 @@ impl VoxelMapMut for FuzzyMap {
                     )
                 })
                 .collect::<Result<Vec<_>>>()?;
-            for (evidence, mut stats) in evidence {
-                stats.voxels_updated = self.apply_evidence(&evidence);
+            for (scan, mut stats) in evidence {
+                stats.voxels_updated = self.apply_scan(&scan);
                 all.push(stats);
             }
         }
@@ -396,5 +486,136 @@ impl VoxelMapMut for FuzzyMap {
             depth_evidence(frame, &c.resolution, &c.evidence, &c.operator, options)?;
         stats.voxels_updated = self.apply_evidence(&evidence);
         Ok(stats)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::{EvidenceModel, cloud_evidence};
+    use nalgebra::Point3;
+
+    /// Points around `origin` at 0.3-25 m, a few of them not finite.
+    fn cloud(origin: Point3<f64>, n: usize, seed: u64) -> PointCloud {
+        let mut state = seed;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64) / ((1u64 << 53) as f64)
+        };
+        let points = (0..n)
+            .map(|i| {
+                if i % 97 == 13 {
+                    return Point3::new(f64::NAN, 0.0, 1.0);
+                }
+                let (a, b, r) = (
+                    next() * std::f64::consts::TAU,
+                    next() * 2.0 - 1.0,
+                    0.3 + next() * 24.7,
+                );
+                let h = (1.0 - b * b).sqrt();
+                origin + nalgebra::Vector3::new(h * a.cos(), h * a.sin(), b) * r
+            })
+            .collect();
+        PointCloud::new(origin, points).unwrap()
+    }
+
+    /// A cloud whose points share one weight is folded from bits for its cleared voxels; the
+    /// map equals, byte for byte, the map folded from the same scan's evidence, with and without
+    /// a maximum range (rays cut there only clear), for confident, clearing-only and
+    /// marking-only weights, under two operators.
+    #[test]
+    fn uniform_clouds_give_the_maps_of_their_evidence() {
+        let weights: [(Option<f32>, Option<f32>); 4] = [
+            (None, None),
+            (Some(0.6), None),
+            (Some(0.0), Some(0.8)),
+            (Some(0.5), Some(0.0)),
+        ];
+        for family in [crate::ops::Family::Product, crate::ops::Family::Minimum] {
+            let operator = TConorm::new(family).unwrap();
+            for (confidence, reliability) in weights {
+                for max_range in [None, Some(8.0)] {
+                    let config = FuzzyConfig {
+                        operator,
+                        ..FuzzyConfig::new(0.1).unwrap()
+                    }
+                    .with_evidence(EvidenceModel::dual());
+                    let options = IntegrationOptions { max_range };
+                    let mut fast = FuzzyMap::new(config).unwrap();
+                    let mut reference = FuzzyMap::new(config).unwrap();
+                    for (k, origin) in [Point3::new(0.0, 0.0, 0.0), Point3::new(1.3, -0.4, 0.2)]
+                        .into_iter()
+                        .enumerate()
+                    {
+                        let mut scan = cloud(origin, 3000, 7 + k as u64);
+                        let n = scan.len();
+                        if let Some(c) = confidence {
+                            scan = scan.with_confidence(vec![c; n]).unwrap();
+                        }
+                        if let Some(r) = reliability {
+                            scan = scan.with_reliability(vec![r; n]).unwrap();
+                        }
+                        let c = &config;
+                        let (form, _) = cloud_scan_checked(
+                            &scan,
+                            &c.resolution,
+                            &c.evidence,
+                            &c.operator,
+                            &options,
+                            Checked::No,
+                        )
+                        .unwrap();
+                        assert!(matches!(form, CloudScan::Uniform { .. }));
+                        let a = fast.integrate_cloud(&scan, &options).unwrap();
+                        let (evidence, b) = cloud_evidence(
+                            &scan,
+                            &c.resolution,
+                            &c.evidence,
+                            &c.operator,
+                            &options,
+                        )
+                        .unwrap();
+                        let updated = reference.apply_evidence(&evidence);
+                        assert_eq!(a.voxels_updated, updated);
+                        assert_eq!(
+                            (a.integrated, a.skipped, a.clipped),
+                            (b.integrated, b.skipped, b.clipped)
+                        );
+                    }
+                    // Each weight gives what it should: occupied evidence from a confidence,
+                    // free evidence from a reliability.
+                    let seen = |f: fn(&Memberships) -> f32| {
+                        VoxelMap::cells(&fast).filter(|(_, m)| f(m) > 0.0).count()
+                    };
+                    assert_eq!(seen(|m| m.occupied) > 0, confidence != Some(0.0));
+                    assert_eq!(seen(|m| m.free) > 0, reliability != Some(0.0));
+                    assert_eq!(fast.to_bytes(), reference.to_bytes());
+                }
+            }
+        }
+    }
+
+    /// Points of different weights keep the per-voxel evidence.
+    #[test]
+    fn clouds_of_mixed_weights_keep_their_evidence() {
+        let config = FuzzyConfig::new(0.1).unwrap();
+        let scan = cloud(Point3::origin(), 500, 3);
+        let n = scan.len();
+        let scan = scan
+            .with_confidence((0..n).map(|i| (i % 5) as f32 / 4.0).collect())
+            .unwrap();
+        let c = &config;
+        let (form, _) = cloud_scan_checked(
+            &scan,
+            &c.resolution,
+            &c.evidence,
+            &c.operator,
+            &IntegrationOptions::default(),
+            Checked::No,
+        )
+        .unwrap();
+        assert!(matches!(form, CloudScan::Evidence(_)));
     }
 }
