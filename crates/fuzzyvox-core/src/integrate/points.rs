@@ -118,17 +118,19 @@ pub(crate) fn cloud_evidence_checked(
         })
         .reduce(
             || (ScanEvidence::new(), IntegrationStats::default()),
-            |(a, sa), (b, sb)| {
-                let stats = IntegrationStats {
-                    integrated: sa.integrated + sb.integrated,
-                    skipped: sa.skipped + sb.skipped,
-                    clipped: sa.clipped + sb.clipped,
-                    voxels_updated: 0,
-                };
-                (merge_max(a, b), stats)
-            },
+            |(a, sa), (b, sb)| (merge_max(a, b), sum_stats(sa, sb)),
         );
     Ok((evidence, stats))
+}
+
+/// The counts of two pieces of one scan (voxels are counted when the scan is applied).
+fn sum_stats(a: IntegrationStats, b: IntegrationStats) -> IntegrationStats {
+    IntegrationStats {
+        integrated: a.integrated + b.integrated,
+        skipped: a.skipped + b.skipped,
+        clipped: a.clipped + b.clipped,
+        voxels_updated: 0,
+    }
 }
 
 /// One scan of a cloud, in the form [`FuzzyMap`](crate::map::FuzzyMap) folds in.
@@ -138,8 +140,9 @@ pub(crate) enum CloudScan {
     /// Every ray carries the same free evidence `free` (a cloud without per-point weights, or
     /// with one weight for all): the occupied evidence as a scan's evidence (its free parts
     /// zero), and the voxels that some ray clears as bits. Folding both gives what
-    /// [`CloudScan::Evidence`] of the same cloud would, in a sixty-fourth of the memory for
-    /// the cleared voxels: most of a scan's time went into zeroing fresh evidence blocks.
+    /// [`CloudScan::Evidence`] of the same cloud would, with 2 bits per cleared voxel (the
+    /// scan sets' blocks) instead of 64: most of a scan's time went into zeroing fresh
+    /// evidence blocks.
     Uniform {
         occupied: ScanEvidence,
         passed: ScanSets,
@@ -230,15 +233,7 @@ pub(crate) fn cloud_scan_checked(
                     IntegrationStats::default(),
                 )
             },
-            |(a, pa, sa), (b, pb, sb)| {
-                let stats = IntegrationStats {
-                    integrated: sa.integrated + sb.integrated,
-                    skipped: sa.skipped + sb.skipped,
-                    clipped: sa.clipped + sb.clipped,
-                    voxels_updated: 0,
-                };
-                (merge_max(a, b), pa.union(pb), stats)
-            },
+            |(a, pa, sa), (b, pb, sb)| (merge_max(a, b), pa.union(pb), sum_stats(sa, sb)),
         );
     let free = model.free(
         operator,

@@ -23,6 +23,21 @@ struct UniformSource<'a> {
     passed: Option<&'a BlockFlags>,
 }
 
+/// Applies `S` between a cell and the evidence `(o, e)`; whether the cell received any.
+#[inline(always)]
+fn fold_cell(acc: &Accumulator, cell: &mut Levels, memo: &mut LevelMemo, o: f32, e: f32) -> bool {
+    if o <= 0.0 && e <= 0.0 {
+        return false;
+    }
+    if o > 0.0 {
+        cell.occupied = acc.accumulate_level(cell.occupied, memo.level(acc, o));
+    }
+    if e > 0.0 {
+        cell.free = acc.accumulate_level(cell.free, memo.level(acc, e));
+    }
+    true
+}
+
 /// The dual-set fuzzy map: two independent membership degrees per voxel, how occupied (μO)
 /// and how free (μE), each aggregated from evidence with a t-conorm `S`:
 /// `μO ← S(μO, o)`, `μE ← S(μE, e)`.
@@ -148,17 +163,7 @@ impl FuzzyMap {
                 0.0
             };
             // As `apply_evidence`: free and not occupied.
-            let e = e * (1.0 - o);
-            if o <= 0.0 && e <= 0.0 {
-                return false;
-            }
-            if o > 0.0 {
-                cell.occupied = acc.accumulate_level(cell.occupied, memo.level(&acc, o));
-            }
-            if e > 0.0 {
-                cell.free = acc.accumulate_level(cell.free, memo.level(&acc, e));
-            }
-            true
+            fold_cell(&acc, cell, memo, o, e * (1.0 - o))
         })
     }
 
@@ -207,16 +212,7 @@ impl FuzzyMap {
         let acc = self.accumulator;
         self.update(source.blocks().collect(), |cell, s, memo| {
             let (o, e) = evidence_of(s);
-            if o <= 0.0 && e <= 0.0 {
-                return false;
-            }
-            if o > 0.0 {
-                cell.occupied = acc.accumulate_level(cell.occupied, memo.level(&acc, o));
-            }
-            if e > 0.0 {
-                cell.free = acc.accumulate_level(cell.free, memo.level(&acc, e));
-            }
-            true
+            fold_cell(&acc, cell, memo, o, e)
         })
     }
 
