@@ -280,7 +280,8 @@ impl FreeTarget for EvidenceCells<'_, '_> {
 }
 
 /// Free evidence as a bit per voxel: every ray of the scan gives the same, so "some ray passed
-/// here" says all (an eighth of a byte per voxel against the eight bytes of [`Evidence`]).
+/// here" says all (the scan sets' blocks: a quarter of a byte per voxel, with the unused hit
+/// bit, against the eight bytes of [`Evidence`]).
 ///
 /// [`Evidence`]: super::Evidence
 struct PassedCells<'a> {
