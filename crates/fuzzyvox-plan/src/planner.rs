@@ -12,7 +12,7 @@ use crate::error::PlanError;
 use crate::field_update::FieldUpdate;
 use crate::path::{Path, plan_in_field};
 use crate::region::PlanningRegion;
-use crate::smooth::{interior_voxels, segment_voxels};
+use crate::smooth::{LegVoxels, legs_clear};
 
 /// The cost field of one region of one map, kept current as the map changes.
 ///
@@ -124,9 +124,7 @@ impl Planner {
         waypoints: &[Point3<f64>],
         avoid: &dyn Fn(usize) -> bool,
     ) -> bool {
-        self.legs_clear(waypoints, avoid, |f, a, b, visit| {
-            segment_voxels(f, a, b, visit)
-        })
+        legs_clear(&self.field, waypoints, avoid, LegVoxels::Ray)
     }
 
     /// Whether a path the planner gave (waypoints at voxel centres, the first where the
@@ -142,36 +140,6 @@ impl Planner {
         waypoints: &[Point3<f64>],
         avoid: &dyn Fn(usize) -> bool,
     ) -> bool {
-        self.legs_clear(waypoints, avoid, |f, a, b, visit| {
-            interior_voxels(f, a, b, visit)
-        })
-    }
-
-    /// Whether `walk` passes every leg of `waypoints` through enterable voxels.
-    fn legs_clear(
-        &self,
-        waypoints: &[Point3<f64>],
-        avoid: &dyn Fn(usize) -> bool,
-        walk: fn(&CostField, VoxelKey, VoxelKey, &mut dyn FnMut(usize) -> bool) -> bool,
-    ) -> bool {
-        let resolution = self.field.resolution();
-        let keys: Option<Vec<VoxelKey>> = waypoints
-            .iter()
-            .map(|p| resolution.key_of(p).ok())
-            .collect();
-        let Some(keys) = keys else {
-            return false;
-        };
-        let region = self.field.region();
-        let Some(first) = keys.first().and_then(|k| region.index_of(*k)) else {
-            return false;
-        };
-        let mut enter = |i: usize| self.field.is_traversable(i) && (i == first || !avoid(i));
-        match keys.as_slice() {
-            [_] => enter(first),
-            _ => keys
-                .windows(2)
-                .all(|leg| walk(&self.field, leg[0], leg[1], &mut enter)),
-        }
+        legs_clear(&self.field, waypoints, avoid, LegVoxels::Interior)
     }
 }

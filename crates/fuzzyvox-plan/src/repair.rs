@@ -91,22 +91,16 @@ pub fn repair_in_field(
 mod tests {
     use super::*;
     use crate::path::tests::open_field;
+    use crate::smooth::{LegVoxels, legs_clear};
 
     fn centre(field: &CostField, key: VoxelKey) -> Point3<f64> {
         field.resolution().center(key)
     }
 
     /// Whether every leg of `waypoints` crosses only voxels the field lets in and `avoid`
-    /// allows, the first waypoint's voxel excepted.
+    /// allows, the first waypoint's voxel excepted (the planner's test of a path it gave).
     fn clear(field: &CostField, waypoints: &[Point3<f64>], avoid: &dyn Fn(usize) -> bool) -> bool {
-        let keys: Vec<VoxelKey> = waypoints
-            .iter()
-            .map(|p| field.resolution().key_of(p).unwrap())
-            .collect();
-        let first = field.region().index_of(keys[0]).unwrap();
-        let enter = |i: usize| field.is_traversable(i) && (i == first || !avoid(i));
-        keys.windows(2)
-            .all(|leg| interior_voxels(field, leg[0], leg[1], enter))
+        legs_clear(field, waypoints, avoid, LegVoxels::Interior)
     }
 
     /// A straight path through where a pillar now stands is repaired round the pillar, joins

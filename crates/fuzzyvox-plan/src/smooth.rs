@@ -3,6 +3,7 @@
 
 use fuzzyvox_core::integrate::walk_ray;
 use fuzzyvox_core::storage::VoxelKey;
+use nalgebra::Point3;
 
 use crate::cost_field::CostField;
 
@@ -83,6 +84,63 @@ pub(crate) fn interior_voxels(
             crossed[a] += 1;
             key[a] += d[a].signum() as i32;
         }
+    }
+}
+
+/// Which voxels a straight leg between two voxel centres counts as crossing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum LegVoxels {
+    /// Every voxel the ray walk visits ([`segment_voxels`]): the test of a step about to be
+    /// taken and of the planner's own shortcuts.
+    Ray,
+    /// The voxels the leg passes through over a positive length ([`interior_voxels`]): the
+    /// test of a path the planner gave.
+    Interior,
+}
+
+impl LegVoxels {
+    /// Visits the voxels the leg from `from` to `to` crosses, as [`segment_voxels`] and
+    /// [`interior_voxels`] do.
+    pub(crate) fn walk(
+        self,
+        field: &CostField,
+        from: VoxelKey,
+        to: VoxelKey,
+        visit: impl FnMut(usize) -> bool,
+    ) -> bool {
+        match self {
+            Self::Ray => segment_voxels(field, from, to, visit),
+            Self::Interior => interior_voxels(field, from, to, visit),
+        }
+    }
+}
+
+/// Whether every leg of `waypoints` crosses, as `legs` counts it, only traversable voxels of
+/// `field` that `avoid` allows, the first waypoint's voxel excepted (the vehicle is there
+/// already); false when a waypoint lies outside the key range or the first outside the region.
+pub(crate) fn legs_clear(
+    field: &CostField,
+    waypoints: &[Point3<f64>],
+    avoid: &dyn Fn(usize) -> bool,
+    legs: LegVoxels,
+) -> bool {
+    let resolution = field.resolution();
+    let keys: Option<Vec<VoxelKey>> = waypoints
+        .iter()
+        .map(|p| resolution.key_of(p).ok())
+        .collect();
+    let Some(keys) = keys else {
+        return false;
+    };
+    let Some(first) = keys.first().and_then(|k| field.region().index_of(*k)) else {
+        return false;
+    };
+    let mut enter = |i: usize| field.is_traversable(i) && (i == first || !avoid(i));
+    match keys.as_slice() {
+        [_] => enter(first),
+        _ => keys
+            .windows(2)
+            .all(|leg| legs.walk(field, leg[0], leg[1], &mut enter)),
     }
 }
 
@@ -289,26 +347,13 @@ mod tests {
         }
     }
 
-    fn visited(
-        field: &CostField,
-        from: VoxelKey,
-        to: VoxelKey,
-        walk: fn(&CostField, VoxelKey, VoxelKey, &mut dyn FnMut(usize) -> bool) -> bool,
-    ) -> Vec<usize> {
+    fn visited(field: &CostField, from: VoxelKey, to: VoxelKey, legs: LegVoxels) -> Vec<usize> {
         let mut seen = Vec::new();
-        assert!(walk(field, from, to, &mut |i| {
+        assert!(legs.walk(field, from, to, |i| {
             seen.push(i);
             true
         }));
         seen
-    }
-
-    fn interior(f: &CostField, a: VoxelKey, b: VoxelKey, v: &mut dyn FnMut(usize) -> bool) -> bool {
-        interior_voxels(f, a, b, v)
-    }
-
-    fn walked(f: &CostField, a: VoxelKey, b: VoxelKey, v: &mut dyn FnMut(usize) -> bool) -> bool {
-        segment_voxels(f, a, b, v)
     }
 
     /// A step to any of the 26 neighbours crosses its two voxels alone; a longer segment
@@ -329,7 +374,7 @@ mod tests {
                     } else {
                         vec![at(20, 20, 10), at(20 + dx, 20 + dy, 10 + dz)]
                     };
-                    assert_eq!(visited(&field, centre, to, interior), expected);
+                    assert_eq!(visited(&field, centre, to, LegVoxels::Interior), expected);
                 }
             }
         }
@@ -337,7 +382,7 @@ mod tests {
             &field,
             VoxelKey::new(3, 7, 2),
             VoxelKey::new(30, 7, 2),
-            interior,
+            LegVoxels::Interior,
         );
         assert_eq!(
             along,
@@ -345,7 +390,7 @@ mod tests {
                 &field,
                 VoxelKey::new(3, 7, 2),
                 VoxelKey::new(30, 7, 2),
-                walked
+                LegVoxels::Ray
             )
         );
         for (from, to) in [
@@ -359,8 +404,8 @@ mod tests {
                 VoxelKey::new(from[0], from[1], from[2]),
                 VoxelKey::new(to[0], to[1], to[2]),
             );
-            let inner = visited(&field, from, to, interior);
-            let ray = visited(&field, from, to, walked);
+            let inner = visited(&field, from, to, LegVoxels::Interior);
+            let ray = visited(&field, from, to, LegVoxels::Ray);
             assert_eq!(inner.first(), Some(&region.index_of(from).unwrap()));
             assert_eq!(inner.last(), Some(&region.index_of(to).unwrap()));
             assert!(inner.iter().all(|i| ray.contains(i)), "{from:?} to {to:?}");

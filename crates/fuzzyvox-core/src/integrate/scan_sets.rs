@@ -252,6 +252,11 @@ impl<B: CellMarks> ScanBlocks<B> {
         self.blocks.get_mut(position)
     }
 
+    /// The marks of block `key`, when a ray reached it.
+    pub(crate) fn block(&self, key: BlockKey) -> Option<&B> {
+        self.index.get(key).and_then(|i| self.blocks.get(i))
+    }
+
     /// Unites two partial scans (exact, so the split does not matter).
     pub(crate) fn union(mut self, other: Self) -> Self {
         if self.blocks.len() < other.blocks.len() {
@@ -270,9 +275,7 @@ impl<B: CellMarks> ScanBlocks<B> {
 impl ScanSets {
     /// Whether a ray passed through `key`, and whether it holds an end point.
     pub fn flags(&self, key: VoxelKey) -> (bool, bool) {
-        self.index
-            .get(key.block())
-            .and_then(|i| self.blocks.get(i))
+        self.block(key.block())
             .map_or((false, false), |block| block.get(key.cell_index()))
     }
 }

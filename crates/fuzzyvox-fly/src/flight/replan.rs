@@ -72,7 +72,8 @@ pub(super) fn replan(
 }
 
 /// Plans through `field` from `position` to the goal, from the voxel [`start_voxel`] gives.
-/// Never enters a voxel `avoid` names (the start excepted). Each search expands at most `limit` voxels; `Ok(None)` when one ran out.
+/// Never enters a voxel `avoid` names (the start excepted). Each search expands at most
+/// `limit` voxels; `Ok(None)` when one ran out.
 fn plan_from(
     field: &CostField,
     position: Point3<f64>,
